@@ -1,0 +1,28 @@
+// Collision with a sphere, an axis-aligned box and the ground plane.
+//
+// After integration every free particle closer than `thickness` to a collider surface is projected out
+// to that distance along the surface normal (the box: along the shortest way out). Friction then acts
+// on the step's tangential displacement like Coulomb friction in position-based dynamics (Mueller et al.
+// 2007, Macklin et al. 2014): the tangential motion is reduced by at most mu times the normal
+// correction, and stops when it is smaller (static friction). A particle resting on a plane is pushed
+// back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
+#pragma once
+
+#include "clothsim/settings.hpp"
+#include "clothsim/state.hpp"
+
+#include <glm/vec3.hpp>
+
+namespace clothsim {
+
+// Signed distance from p to the collider surface (m): negative inside.
+float signed_distance(const SphereCollider& sphere, glm::vec3 p);
+float signed_distance(const CubeCollider& cube, glm::vec3 p);
+float signed_distance(const GroundCollider& ground, glm::vec3 p);
+
+// Collision stages. Pinned particles are never moved.
+void collide(State& state, const SphereCollider& sphere, float thickness);
+void collide(State& state, const CubeCollider& cube, float thickness);
+void collide(State& state, const GroundCollider& ground, float thickness);
+
+}  // namespace clothsim

@@ -1,0 +1,84 @@
+// MassSpring: a cloth of particles joined by Hooke springs, advanced by position Verlet.
+//
+// The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
+// accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,
+// ground). Topology is fixed at construction; SimulationSettings may be edited between steps (stiffness,
+// damping, forces, colliders, dt, substeps) and take effect at the next step.
+#pragma once
+
+#include "clothsim/particle.hpp"
+#include "clothsim/settings.hpp"
+#include "clothsim/state.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace clothsim {
+
+struct Energy {
+    double kinetic = 0.0;            // J: sum of m v^2 / 2 with second-order velocities
+    double spring_potential = 0.0;   // J: sum of k (|d| - L0)^2 / 2
+    double gravity_potential = 0.0;  // J: -sum of m g . x over free particles
+    double potential() const { return spring_potential + gravity_potential; }
+    double total() const { return kinetic + potential(); }
+};
+
+class MassSpring {
+public:
+    // `state.position` holds the start positions; `initial_velocity` (one per particle, or empty for rest)
+    // sets the start velocities. Previous positions are derived from them (second-order start).
+    MassSpring(Topology topology, State state, SimulationSettings settings,
+               const std::vector<glm::vec3>& initial_velocity = {});
+
+    // One integration substep of length substep_length().
+    void step();
+    // `steps` whole steps of settings().integration.dt, each made of `substeps` substeps.
+    void run_steps(long long steps);
+    // Advances by whole substeps covering `seconds` plus what earlier calls left over; returns the number of
+    // substeps run. The remainder (< one substep) is carried to the next call.
+    long long advance(double seconds);
+
+    float substep_length() const;  // s: dt / substeps
+
+    SimulationSettings& settings() { return settings_; }
+    const SimulationSettings& settings() const { return settings_; }
+    const Topology& topology() const { return topology_; }
+    const State& state() const { return state_; }
+
+    std::size_t particle_count() const { return state_.size(); }
+    std::size_t spring_count() const { return topology_.springs.size(); }
+    double time() const { return state_.time; }
+    float rest_area() const { return rest_area_; }
+
+    Particle particle(std::size_t i) const;
+    glm::vec3 position(std::size_t i) const { return state_.position.get(i); }
+    std::vector<glm::vec3> positions() const;
+    // Second-order velocity estimates at the current positions (m/s).
+    std::vector<glm::vec3> velocities() const;
+    Energy energy() const;
+    glm::vec3 momentum() const;  // kg m/s, free particles
+    bool all_finite() const;
+
+    // Pins or frees a particle; a newly pinned particle stops where it is.
+    void set_pinned(std::size_t i, bool pinned);
+    // Moves a particle and gives it a velocity (for grabbing and for tests); others keep theirs.
+    void set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity);
+
+private:
+    // Restarts Verlet from velocities at the current positions with substep h (used at construction and
+    // when the substep length changes, so a new dt does not turn into a velocity jump).
+    void restart(const std::vector<glm::vec3>& velocity, float h);
+    void compute_forces(const State& state, Vec3Array& force) const;
+
+    Topology topology_;
+    State state_;
+    SimulationSettings settings_;
+    Vec3Array force_;        // N, scratch of the current substep
+    float rest_area_ = 0.0f; // m^2: sum of the triangles' rest areas
+    double carry_ = 0.0;     // s: time advance() has not yet stepped
+};
+
+}  // namespace clothsim

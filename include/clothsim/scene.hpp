@@ -1,0 +1,77 @@
+// Scenes: the TOML files in assets/scenes/, the `--set key=value` overrides, and the builder that turns a
+// Scene into a running MassSpring. The app, the tests and the benchmarks all build cloth through
+// build_simulation(), so they simulate exactly the same thing.
+#pragma once
+
+#include "clothsim/mass_spring.hpp"
+#include "clothsim/settings.hpp"
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace clothsim {
+
+// A scene that cannot be loaded, overridden or built. The message names the source (file and line, or the
+// --set flag), the field, the value and what is allowed.
+class SceneError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
+using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*>;
+
+struct FieldInfo {
+    std::string_view name;  // dotted name, as in the scene file and --set
+    std::string_view unit;  // "" when dimensionless
+    double min;             // valid range (inclusive), per component for vectors
+    double max;
+    std::string_view help;  // one line
+    FieldRef (*ref)(Scene&);
+};
+
+std::span<const FieldInfo> scene_fields();
+const FieldInfo* find_field(std::string_view name);
+// "allowed values" of a field, as written in messages and in the README: "an integer in [1, 2048]".
+std::string describe_allowed(const FieldInfo& field);
+// A field's current value as TOML text ("[0.0, -9.81, 0.0]", "\"top-corners\"").
+std::string format_value(const Scene& scene, const FieldInfo& field);
+
+// ---- Names of the enumerations, as written in files. ----
+std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
+std::span<const std::string_view> wind_model_names();   // triangles, uniform
+
+// ---- Loading and overriding. All throw SceneError; on a throw the target scene is left unchanged. ----
+Scene parse_scene(std::string_view toml_text, std::string_view source_name);
+Scene load_scene_file(const std::filesystem::path& path);
+// A bundled scene name ("hanging") or a path to a .toml file.
+Scene load_scene(std::string_view name_or_path);
+// `key=value`: value is TOML ("128", "[0, -9.81, 0]", "true", "\"x\"") or a bare word ("top-row").
+void apply_override(Scene& scene, std::string_view assignment);
+// Every field range, and the checks that span fields (axes, pins inside the grid, grid size).
+void validate(const Scene& scene);
+// The whole scene as a TOML document that parse_scene() reads back to the same Scene.
+std::string to_toml(const Scene& scene);
+
+std::filesystem::path scene_directory();  // $CLOTHSIM_SCENES, else the source tree's assets/scenes
+std::vector<std::string> bundled_scene_names();
+
+// Largest grid accepted (particles); larger grids are rejected with a message, not attempted.
+inline constexpr long long kMaxParticles = 1024LL * 1024LL;
+
+// ---- Building. ----
+// Pinned particle indices (row-major) for a cloth; throws SceneError for a pin outside the grid.
+std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins);
+// The particles, springs and triangles of the grid, and the ready-to-step simulation. Throws SceneError.
+MassSpring build_simulation(const Scene& scene);
+
+}  // namespace clothsim

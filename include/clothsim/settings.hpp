@@ -1,0 +1,109 @@
+// Settings of a scene, with their defaults.
+//
+// These plain structs are what a scene file loads into, what `--set` overrides and what the panel edits.
+// Each field's unit, valid range and one-line meaning are listed once, in src/core/scene_fields.cpp
+// (the field table); the comments here only repeat the unit.
+#pragma once
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace clothsim {
+
+// Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
+enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
+
+// How wind acts on the cloth.
+enum class WindModel {
+    Triangles,  // pressure on each triangle along its normal: an edge-on sheet feels none, a flag flutters
+    Uniform,    // the seed's isotropic drag toward the air velocity, the same for every particle
+};
+
+struct ClothSettings {
+    int rows = 32;                           // particles along v_axis (count)
+    int cols = 32;                           // particles along u_axis (count)
+    glm::vec2 size{1.0f, 1.0f};              // m: extent along u_axis, along v_axis
+    float mass = 0.5f;                       // kg: total, shared equally by all particles
+    glm::vec3 origin{-0.5f, 1.5f, 0.0f};     // m: position of particle (row 0, col 0)
+    glm::vec3 u_axis{1.0f, 0.0f, 0.0f};      // direction of increasing column (normalised when built)
+    glm::vec3 v_axis{0.0f, -1.0f, 0.0f};     // direction of increasing row (normalised when built)
+    glm::vec3 velocity{0.0f, 0.0f, 0.0f};    // m/s: initial velocity of every free particle
+};
+
+struct SpringSettings {
+    float structural = 400.0f;  // N/m: horizontal and vertical neighbours
+    float shear = 40.0f;        // N/m: both diagonals
+    float bending = 10.0f;      // N/m: two apart along rows and columns
+    float damping = 0.2f;       // 1/s: velocity damping rate c in x'' = a - c x'
+};
+
+struct ForceSettings {
+    glm::vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
+    glm::vec3 wind{0.0f, 0.0f, 0.0f};       // m/s: air velocity
+    WindModel wind_model = WindModel::Triangles;
+    float drag = 0.6f;                      // kg/m^3: 0.5 * air density * drag coefficient
+    float gust_strength = 0.0f;             // fraction of the wind speed added and removed by gusts
+    float gust_frequency = 0.5f;            // Hz: main gust frequency
+};
+
+// Which particles are pinned: a named preset and/or explicit (row, col) pairs.
+struct PinSpec {
+    PinPreset preset = PinPreset::TopCorners;
+    std::vector<std::pair<int, int>> particles;  // (row, col), in addition to the preset
+    bool operator==(const PinSpec&) const = default;
+};
+
+struct SphereCollider {
+    bool enabled = false;
+    glm::vec3 center{0.0f, 0.5f, 0.0f};  // m
+    float radius = 0.3f;                 // m
+    float friction = 0.3f;               // Coulomb coefficient (0 = frictionless)
+};
+
+struct CubeCollider {
+    bool enabled = false;
+    glm::vec3 center{0.0f, 0.4f, 0.0f};     // m
+    glm::vec3 size{0.5f, 0.5f, 0.5f};       // m: edge lengths along x, y, z (axis-aligned)
+    float friction = 0.3f;
+};
+
+struct GroundCollider {
+    bool enabled = true;
+    float height = 0.0f;     // m: the plane y = height
+    float friction = 0.5f;
+};
+
+struct ColliderSettings {
+    SphereCollider sphere;
+    CubeCollider cube;
+    GroundCollider ground;
+    float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
+};
+
+struct IntegrationSettings {
+    float dt = 1.0f / 60.0f;  // s: one step (one frame of the app)
+    int substeps = 25;        // integration substeps per step; each advances dt / substeps
+};
+
+// The settings a running simulation reads every step; all of them may change live.
+struct SimulationSettings {
+    SpringSettings springs;
+    ForceSettings forces;
+    ColliderSettings colliders;
+    IntegrationSettings integration;
+};
+
+// Everything a scene file holds. Changing cloth or pins needs a rebuild; the rest applies live.
+struct Scene {
+    std::string name = "untitled";
+    std::string description;
+    ClothSettings cloth;
+    PinSpec pins;
+    SimulationSettings settings;
+};
+
+}  // namespace clothsim

@@ -1,0 +1,63 @@
+// Setup apart from state (as Jolt's SoftBodySharedSettings / SoftBodyMotionProperties):
+//  - Topology is built once per cloth: grid shape, spring list, triangles.
+//  - State changes every step and is laid out as structure of arrays for the hot loops.
+#pragma once
+
+#include "clothsim/spring.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace clothsim {
+
+// Three coordinate arrays of equal length: the layout the spring and integration loops want.
+struct Vec3Array {
+    std::vector<float> x, y, z;
+
+    std::size_t size() const { return x.size(); }
+    void resize(std::size_t n, float value = 0.0f) {
+        x.assign(n, value);
+        y.assign(n, value);
+        z.assign(n, value);
+    }
+    glm::vec3 get(std::size_t i) const { return {x[i], y[i], z[i]}; }
+    void set(std::size_t i, glm::vec3 v) {
+        x[i] = v.x;
+        y[i] = v.y;
+        z[i] = v.z;
+    }
+    void add(std::size_t i, glm::vec3 v) {
+        x[i] += v.x;
+        y[i] += v.y;
+        z[i] += v.z;
+    }
+    bool operator==(const Vec3Array&) const = default;
+};
+
+struct Topology {
+    int rows = 0;
+    int cols = 0;
+    std::vector<Spring> springs;
+    std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
+    std::array<std::size_t, kSpringKindCount> spring_count_by_kind{};
+
+    std::size_t index(int row, int col) const { return static_cast<std::size_t>(row) * cols + col; }
+};
+
+struct State {
+    Vec3Array position;           // m
+    Vec3Array previous_position;  // m, one substep of length `substep` ago
+    std::vector<float> mass;      // kg (kept for pinned particles too, for energy and momentum)
+    std::vector<float> inverse_mass;  // 1/kg, 0 for pinned particles
+    std::vector<std::uint8_t> pinned;
+    double time = 0.0;            // s
+    float substep = 0.0f;         // s: the step previous_position belongs to
+
+    std::size_t size() const { return position.size(); }
+};
+
+}  // namespace clothsim

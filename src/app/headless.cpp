@@ -1,0 +1,105 @@
+#include "headless.hpp"
+
+#include "clothsim/export.hpp"
+#include "clothsim/scene.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace clothsim {
+namespace {
+
+bool parent_exists(const std::string& path) {
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    return parent.empty() || std::filesystem::is_directory(parent);
+}
+
+}  // namespace
+
+int run_headless(const Scene& scene, const HeadlessOptions& options) {
+    MassSpring sim = build_simulation(scene);
+    const double dt = scene.settings.integration.dt;
+    const long long steps = options.steps ? *options.steps
+                            : options.duration ? std::llround(*options.duration / dt)
+                                               : std::llround(1.0 / dt);
+
+    // Check outputs before simulating, so a long run never fails at its end.
+    std::unique_ptr<TrajectoryWriter> trajectory;
+    if (!options.trajectory.empty()) {
+        trajectory = std::make_unique<TrajectoryWriter>(options.trajectory);
+        if (!trajectory->ok()) {
+            std::cerr << "clothsim: error: " << trajectory->error() << "\n";
+            return kExitBadInput;
+        }
+        trajectory->record(0, sim);
+    }
+    if (!options.obj.empty() && !parent_exists(options.obj)) {
+        std::cerr << "clothsim: error: --obj " << options.obj << ": the directory does not exist\n";
+        return kExitBadInput;
+    }
+
+    const auto start = std::chrono::steady_clock::now();
+    long long done = 0;
+    bool finite = sim.all_finite();
+    while (finite && done < steps) {
+        sim.run_steps(1);
+        ++done;
+        finite = sim.all_finite();
+        if (trajectory && (done % options.every == 0 || done == steps || !finite)) trajectory->record(done, sim);
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    int code = kExitOk;
+    if (trajectory && !trajectory->finish()) {
+        std::cerr << "clothsim: error: " << trajectory->error() << "\n";
+        code = kExitBadInput;
+    }
+    if (!options.obj.empty()) {
+        std::string error;
+        if (!write_obj(sim, options.obj, error)) {
+            std::cerr << "clothsim: error: " << error << "\n";
+            code = kExitBadInput;
+        }
+    }
+    if (!finite) {
+        std::cerr << "clothsim: error: the simulation became non-finite at t = " << sim.time() << " s (step " << done
+                  << "); try a smaller integration.dt, more integration.substeps or softer springs\n";
+        code = kExitNonFinite;
+    }
+
+    const Energy e = sim.energy();
+    const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    if (options.json) {
+        nlohmann::json out = {
+            {"scene", scene.name},
+            {"particles", sim.particle_count()},
+            {"springs", sim.spring_count()},
+            {"steps", done},
+            {"substeps_per_step", scene.settings.integration.substeps},
+            {"dt", dt},
+            {"simulated_seconds", sim.time()},
+            {"wall_seconds", wall},
+            {"finite", finite},
+            {"kinetic_energy", finite_or_null(e.kinetic)},
+            {"potential_energy", finite_or_null(e.potential())},
+            {"total_energy", finite_or_null(e.total())},
+        };
+        std::cout << out.dump(2) << std::endl;
+    } else {
+        std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(),
+                    sim.spring_count());
+        std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", done, dt,
+                    scene.settings.integration.substeps, sim.time(), wall);
+        std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
+                    e.total(), finite ? "yes" : "no");
+    }
+    return code;
+}
+
+}  // namespace clothsim

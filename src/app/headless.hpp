@@ -1,0 +1,27 @@
+// Headless runs: simulate a scene without a window and report on stdout (text or one JSON object).
+#pragma once
+
+#include "clothsim/settings.hpp"
+
+#include <optional>
+#include <string>
+
+namespace clothsim {
+
+struct HeadlessOptions {
+    std::optional<double> duration;  // s of simulated time (rounded to whole steps)
+    std::optional<long long> steps;  // steps of integration.dt
+    std::string trajectory;          // CSV path, empty for none
+    long long every = 1;             // record the trajectory every K steps
+    std::string obj;                 // OBJ path of the final mesh, empty for none
+    bool json = false;
+};
+
+// Exit codes of the clothsim executable.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitNonFinite = 3;
+
+int run_headless(const Scene& scene, const HeadlessOptions& options);
+
+}  // namespace clothsim

@@ -1,0 +1,95 @@
+#include "clothsim/colliders.hpp"
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace clothsim {
+namespace {
+
+// Where a particle touches a collider: the outward unit normal and how far to move along it.
+struct Contact {
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    float depth = 0.0f;  // > 0 when the particle is closer than `thickness`
+};
+
+Contact contact(const SphereCollider& sphere, glm::vec3 p, float thickness) {
+    const glm::vec3 d = p - sphere.center;
+    const float length = glm::length(d);
+    Contact c;
+    // A particle exactly at the centre has no direction: push it straight up.
+    if (length > 1e-12f) c.normal = d / length;
+    c.depth = sphere.radius + thickness - length;
+    return c;
+}
+
+Contact contact(const CubeCollider& cube, glm::vec3 p, float thickness) {
+    const glm::vec3 local = p - cube.center;
+    const glm::vec3 q = glm::abs(local) - 0.5f * cube.size;  // per-axis distance outside a face
+    const glm::vec3 side(local.x < 0.0f ? -1.0f : 1.0f, local.y < 0.0f ? -1.0f : 1.0f,
+                         local.z < 0.0f ? -1.0f : 1.0f);
+    Contact c;
+    const float q_max = std::max({q.x, q.y, q.z});
+    if (q_max <= 0.0f) {
+        // Inside or on the surface: leave through the nearest face (the axis with the largest q).
+        const int axis = q.x == q_max ? 0 : (q.y == q_max ? 1 : 2);
+        c.normal = glm::vec3(0.0f);
+        c.normal[axis] = side[axis];
+        c.depth = thickness - q_max;
+        return c;
+    }
+    const glm::vec3 outside = glm::max(q, glm::vec3(0.0f)) * side;
+    const float distance = glm::length(outside);
+    c.normal = outside / distance;
+    c.depth = thickness - distance;
+    return c;
+}
+
+Contact contact(const GroundCollider& ground, glm::vec3 p, float thickness) {
+    return {glm::vec3(0.0f, 1.0f, 0.0f), ground.height + thickness - p.y};
+}
+
+template <class Shape>
+void collide_shape(State& state, const Shape& shape, float friction, float thickness) {
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        if (state.pinned[i]) continue;
+        glm::vec3 x = state.position.get(i);
+        const Contact c = contact(shape, x, thickness);
+        if (!(c.depth > 0.0f)) continue;
+        x += c.normal * c.depth;
+        if (friction > 0.0f) {
+            const glm::vec3 step = x - state.previous_position.get(i);
+            const glm::vec3 tangential = step - glm::dot(step, c.normal) * c.normal;
+            const float slide = glm::length(tangential);
+            if (slide > 0.0f) x -= tangential * (std::min(slide, friction * c.depth) / slide);
+        }
+        state.position.set(i, x);
+    }
+}
+
+}  // namespace
+
+float signed_distance(const SphereCollider& sphere, glm::vec3 p) {
+    return glm::length(p - sphere.center) - sphere.radius;
+}
+
+float signed_distance(const CubeCollider& cube, glm::vec3 p) {
+    const glm::vec3 q = glm::abs(p - cube.center) - 0.5f * cube.size;
+    return glm::length(glm::max(q, glm::vec3(0.0f))) + std::min(std::max({q.x, q.y, q.z}), 0.0f);
+}
+
+float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
+
+void collide(State& state, const SphereCollider& sphere, float thickness) {
+    collide_shape(state, sphere, sphere.friction, thickness);
+}
+void collide(State& state, const CubeCollider& cube, float thickness) {
+    collide_shape(state, cube, cube.friction, thickness);
+}
+void collide(State& state, const GroundCollider& ground, float thickness) {
+    collide_shape(state, ground, ground.friction, thickness);
+}
+
+}  // namespace clothsim

@@ -1,0 +1,40 @@
+// Force stages of a time step. Each adds its contribution (N) to `force`; none clears it.
+#pragma once
+
+#include "clothsim/settings.hpp"
+#include "clothsim/state.hpp"
+
+namespace clothsim {
+
+// Hooke springs, F_a = k (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b. A spring with L0 = 0 uses
+// F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
+// and contributes nothing rather than NaN.
+void accumulate_spring_forces(const Topology& topology, const Vec3Array& position,
+                              const SpringSettings& springs, Vec3Array& force);
+
+// Air velocity at a time: the wind vector scaled by deterministic gusts (two incommensurate sines, so a
+// run is reproducible and still looks irregular).
+glm::vec3 wind_velocity(const ForceSettings& forces, double time);
+
+// Aerodynamic pressure. Triangles model: each triangle of area A and unit normal n, moving with the mean
+// velocity v of its corners, feels F = drag * A * (w_rel . n) |w_rel . n| n with w_rel = w - v, shared
+// equally by its corners; a sheet edge-on to the wind feels nothing. Uniform model: every particle feels
+// drag * (A_total / N) * |w_rel| w_rel. Velocities are the first-order (x - x_prev) / h.
+void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
+                            float rest_area, Vec3Array& force);
+
+// Elastic energy 0.5 k (|d| - L0)^2 summed over springs (J).
+double spring_potential_energy(const Topology& topology, const Vec3Array& position,
+                               const SpringSettings& springs);
+
+// Spring stiffness for a kind (N/m).
+inline float stiffness_of(const SpringSettings& springs, SpringKind kind) {
+    switch (kind) {
+        case SpringKind::Structural: return springs.structural;
+        case SpringKind::Shear: return springs.shear;
+        case SpringKind::Bending: return springs.bending;
+    }
+    return 0.0f;
+}
+
+}  // namespace clothsim

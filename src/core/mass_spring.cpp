@@ -1,0 +1,143 @@
+#include "clothsim/mass_spring.hpp"
+
+#include "clothsim/colliders.hpp"
+#include "forces.hpp"
+#include "verlet.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace clothsim {
+
+MassSpring::MassSpring(Topology topology, State state, SimulationSettings settings,
+                       const std::vector<glm::vec3>& initial_velocity)
+    : topology_(std::move(topology)), state_(std::move(state)), settings_(settings) {
+    const std::size_t n = state_.size();
+    if (state_.mass.size() != n || state_.inverse_mass.size() != n || state_.pinned.size() != n ||
+        (!initial_velocity.empty() && initial_velocity.size() != n)) {
+        throw std::invalid_argument("MassSpring: state arrays and initial velocities must have equal length");
+    }
+    for (const auto& t : topology_.triangles) {
+        const glm::vec3 a = state_.position.get(t[0]);
+        rest_area_ += 0.5f * glm::length(glm::cross(state_.position.get(t[1]) - a, state_.position.get(t[2]) - a));
+    }
+    force_.resize(n);
+    state_.previous_position = state_.position;
+    restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
+            substep_length());
+}
+
+float MassSpring::substep_length() const {
+    return settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
+}
+
+// The whole pipeline of one substep, in order.
+void MassSpring::step() {
+    const float h = substep_length();
+    if (h != state_.substep) restart(velocities(), h);
+
+    compute_forces(state_, force_);
+    integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+    const ColliderSettings& colliders = settings_.colliders;
+    if (colliders.sphere.enabled) collide(state_, colliders.sphere, colliders.thickness);
+    if (colliders.cube.enabled) collide(state_, colliders.cube, colliders.thickness);
+    if (colliders.ground.enabled) collide(state_, colliders.ground, colliders.thickness);
+
+    state_.time += h;
+}
+
+void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
+    force.resize(state.size());
+    accumulate_spring_forces(topology_, state.position, settings_.springs, force);
+    const ForceSettings& forces = settings_.forces;
+    if (forces.wind != glm::vec3(0.0f) || forces.wind_model == WindModel::Uniform) {
+        accumulate_wind_forces(topology_, state, forces, rest_area_, force);
+    }
+}
+
+void MassSpring::run_steps(long long steps) {
+    for (long long s = 0; s < steps; ++s) {
+        for (int i = 0; i < settings_.integration.substeps; ++i) step();
+    }
+}
+
+long long MassSpring::advance(double seconds) {
+    carry_ += seconds;
+    const double h = substep_length();
+    // The small tolerance keeps 1/60 s from becoming 9.9999 substeps of 1/600 s through rounding.
+    const auto n = static_cast<long long>(std::floor(carry_ / h + 1e-6));
+    for (long long i = 0; i < n; ++i) step();
+    carry_ = std::max(0.0, carry_ - static_cast<double>(n) * h);
+    return n;
+}
+
+void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
+    compute_forces(state_, force_);
+    start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
+}
+
+Particle MassSpring::particle(std::size_t i) const {
+    return {state_.position.get(i), state_.previous_position.get(i), state_.mass[i], state_.pinned[i] != 0};
+}
+
+std::vector<glm::vec3> MassSpring::positions() const {
+    std::vector<glm::vec3> p(state_.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = state_.position.get(i);
+    return p;
+}
+
+std::vector<glm::vec3> MassSpring::velocities() const {
+    Vec3Array force;
+    compute_forces(state_, force);
+    return verlet_velocities(state_, force, settings_.forces.gravity, settings_.springs.damping);
+}
+
+Energy MassSpring::energy() const {
+    Energy e;
+    const std::vector<glm::vec3> v = velocities();
+    const glm::dvec3 g(settings_.forces.gravity);
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        if (state_.pinned[i]) continue;
+        const double m = state_.mass[i];
+        e.kinetic += 0.5 * m * glm::dot(glm::dvec3(v[i]), glm::dvec3(v[i]));
+        e.gravity_potential -= m * glm::dot(g, glm::dvec3(state_.position.get(i)));
+    }
+    e.spring_potential = spring_potential_energy(topology_, state_.position, settings_.springs);
+    return e;
+}
+
+glm::vec3 MassSpring::momentum() const {
+    const std::vector<glm::vec3> v = velocities();
+    glm::dvec3 p(0.0);
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        if (!state_.pinned[i]) p += double(state_.mass[i]) * glm::dvec3(v[i]);
+    }
+    return glm::vec3(p);
+}
+
+bool MassSpring::all_finite() const {
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        if (!std::isfinite(state_.position.x[i]) || !std::isfinite(state_.position.y[i]) ||
+            !std::isfinite(state_.position.z[i])) {
+            return false;
+        }
+    }
+    return true;
+}
+
+void MassSpring::set_pinned(std::size_t i, bool pinned) {
+    state_.pinned.at(i) = pinned ? 1 : 0;
+    state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
+    if (pinned) state_.previous_position.set(i, state_.position.get(i));
+}
+
+void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {
+    std::vector<glm::vec3> v = velocities();
+    state_.position.set(i, position);
+    v.at(i) = state_.pinned[i] ? glm::vec3(0.0f) : velocity;
+    restart(v, substep_length());
+}
+
+}  // namespace clothsim

@@ -1,0 +1,199 @@
+// The one place that says each scene field's unit, valid range and meaning. The loader, --set, validate(),
+// to_toml(), the README's field list and (later) the panel's tooltips all read this table.
+#include "clothsim/scene.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace clothsim {
+namespace {
+
+constexpr double kBig = 1e4;
+
+// clang-format off
+const std::array kFields = {
+    FieldInfo{"name", "", 0, 0, "scene name", [](Scene& s) -> FieldRef { return &s.name; }},
+    FieldInfo{"description", "", 0, 0, "one-line description", [](Scene& s) -> FieldRef { return &s.description; }},
+
+    FieldInfo{"cloth.rows", "", 1, 2048, "particles along v_axis (rows x cols <= 1048576)", [](Scene& s) -> FieldRef { return &s.cloth.rows; }},
+    FieldInfo{"cloth.cols", "", 1, 2048, "particles along u_axis", [](Scene& s) -> FieldRef { return &s.cloth.cols; }},
+    FieldInfo{"cloth.size", "m", 1e-3, 1e3, "[width along u_axis, height along v_axis]; one number for a square", [](Scene& s) -> FieldRef { return &s.cloth.size; }},
+    FieldInfo{"cloth.mass", "kg", 1e-6, 1e6, "total mass, shared equally by all particles", [](Scene& s) -> FieldRef { return &s.cloth.mass; }},
+    FieldInfo{"cloth.origin", "m", -kBig, kBig, "position of particle (row 0, col 0)", [](Scene& s) -> FieldRef { return &s.cloth.origin; }},
+    FieldInfo{"cloth.u_axis", "", -1e3, 1e3, "direction of increasing column (normalised; not parallel to v_axis)", [](Scene& s) -> FieldRef { return &s.cloth.u_axis; }},
+    FieldInfo{"cloth.v_axis", "", -1e3, 1e3, "direction of increasing row (normalised)", [](Scene& s) -> FieldRef { return &s.cloth.v_axis; }},
+    FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
+
+    FieldInfo{"springs.structural", "N/m", 0, 1e9, "stiffness of horizontal and vertical neighbour springs", [](Scene& s) -> FieldRef { return &s.settings.springs.structural; }},
+    FieldInfo{"springs.shear", "N/m", 0, 1e9, "stiffness of diagonal springs", [](Scene& s) -> FieldRef { return &s.settings.springs.shear; }},
+    FieldInfo{"springs.bending", "N/m", 0, 1e9, "stiffness of springs two apart along rows and columns", [](Scene& s) -> FieldRef { return &s.settings.springs.bending; }},
+    FieldInfo{"springs.damping", "1/s", 0, 1e4, "velocity damping rate c in x'' = a - c x' (independent of dt)", [](Scene& s) -> FieldRef { return &s.settings.springs.damping; }},
+
+    FieldInfo{"forces.gravity", "m/s^2", -1e5, 1e5, "gravitational acceleration", [](Scene& s) -> FieldRef { return &s.settings.forces.gravity; }},
+    FieldInfo{"forces.wind", "m/s", -kBig, kBig, "air velocity", [](Scene& s) -> FieldRef { return &s.settings.forces.wind; }},
+    FieldInfo{"forces.wind_model", "", 0, 0, "triangles: pressure on each triangle's normal; uniform: the same drag on every particle", [](Scene& s) -> FieldRef { return &s.settings.forces.wind_model; }},
+    FieldInfo{"forces.drag", "kg/m^3", 0, 1e3, "0.5 x air density x drag coefficient", [](Scene& s) -> FieldRef { return &s.settings.forces.drag; }},
+    FieldInfo{"forces.gust_strength", "", 0, 1, "fraction of the wind speed gusts add and remove", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_strength; }},
+    FieldInfo{"forces.gust_frequency", "Hz", 0, 100, "main gust frequency", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_frequency; }},
+
+    FieldInfo{"pins", "", 0, 0, "a preset name, a list of [row, col], or { preset = NAME, particles = [[row, col], ...] }", [](Scene& s) -> FieldRef { return &s.pins; }},
+
+    FieldInfo{"colliders.sphere.enabled", "", 0, 0, "collide with the sphere", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.enabled; }},
+    FieldInfo{"colliders.sphere.center", "m", -kBig, kBig, "sphere centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.center; }},
+    FieldInfo{"colliders.sphere.radius", "m", 0, kBig, "sphere radius", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.radius; }},
+    FieldInfo{"colliders.sphere.friction", "", 0, 10, "Coulomb friction coefficient (0 = frictionless)", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.friction; }},
+    FieldInfo{"colliders.cube.enabled", "", 0, 0, "collide with the axis-aligned cube (box)", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.enabled; }},
+    FieldInfo{"colliders.cube.center", "m", -kBig, kBig, "box centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.center; }},
+    FieldInfo{"colliders.cube.size", "m", 0, kBig, "box edge lengths along x, y, z", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.size; }},
+    FieldInfo{"colliders.cube.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.friction; }},
+    FieldInfo{"colliders.ground.enabled", "", 0, 0, "collide with the ground plane y = height", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.enabled; }},
+    FieldInfo{"colliders.ground.height", "m", -kBig, kBig, "ground height", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.height; }},
+    FieldInfo{"colliders.ground.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.friction; }},
+    FieldInfo{"colliders.thickness", "m", 0, 1, "distance particles keep from every collider surface", [](Scene& s) -> FieldRef { return &s.settings.colliders.thickness; }},
+
+    FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
+    FieldInfo{"integration.substeps", "", 1, 10000, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
+};
+// clang-format on
+
+constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corners", "top-row", "four-corners",
+                                                             "left-edge"};
+constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
+
+std::string number(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.9g", v);
+    std::string s = buffer;
+    // Keep TOML floats floats: "1" would read back as an integer.
+    if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+    return s;
+}
+
+// Appends instead of operator+ chains: GCC 12 warns falsely (-Wrestrict, GCC bug 105329) on "literal" + string.
+template <class... Parts>
+std::string cat(const Parts&... parts) {
+    std::string s;
+    (s.append(std::string_view(parts)), ...);
+    return s;
+}
+
+std::string range(const FieldInfo& f) { return cat("[", number(f.min), ", ", number(f.max), "]"); }
+
+template <class... Ts>
+struct Overloaded : Ts... {
+    using Ts::operator()...;
+};
+
+}  // namespace
+
+std::span<const FieldInfo> scene_fields() { return kFields; }
+
+const FieldInfo* find_field(std::string_view name) {
+    for (const FieldInfo& f : kFields) {
+        if (f.name == name) return &f;
+    }
+    return nullptr;
+}
+
+std::span<const std::string_view> pin_preset_names() { return kPinPresetNames; }
+std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
+
+std::string describe_allowed(const FieldInfo& field) {
+    Scene scratch;
+    const std::string unit = field.unit.empty() ? "" : cat(" ", field.unit);
+    auto join = [](std::span<const std::string_view> names) {
+        std::string s;
+        for (std::size_t i = 0; i < names.size(); ++i) s += cat(i ? ", " : "", names[i]);
+        return s;
+    };
+    return std::visit(
+        Overloaded{
+            [&](int*) { return cat("an integer in [", std::to_string(int(field.min)), ", ", std::to_string(int(field.max)), "]"); },
+            [&](float*) { return cat("a number in ", range(field), unit); },
+            [&](bool*) { return std::string("true or false"); },
+            [&](glm::vec2*) { return cat("one number or [x, y], each in ", range(field), unit); },
+            [&](glm::vec3*) { return cat("[x, y, z], each in ", range(field), unit); },
+            [&](std::string*) { return std::string("a string"); },
+            [&](PinSpec*) { return "one of " + join(kPinPresetNames) + ", a list of [row, col], or a table with preset and particles"; },
+            [&](WindModel*) { return "one of " + join(kWindModelNames); },
+        },
+        field.ref(scratch));
+}
+
+std::string format_value(const Scene& scene, const FieldInfo& field) {
+    // The table hands out mutable references; reading through one here changes nothing.
+    Scene& s = const_cast<Scene&>(scene);
+    auto quoted = [](std::string_view text) {
+        std::string out = "\"";
+        for (char c : text) {
+            if (c == '"' || c == '\\') out += '\\';
+            if (c == '\n') { out += "\\n"; continue; }
+            out += c;
+        }
+        return out + "\"";
+    };
+    return std::visit(
+        Overloaded{
+            [&](int* v) { return std::to_string(*v); },
+            [&](float* v) { return number(*v); },
+            [&](bool* v) { return std::string(*v ? "true" : "false"); },
+            [&](glm::vec2* v) { return cat("[", number(v->x), ", ", number(v->y), "]"); },
+            [&](glm::vec3* v) { return cat("[", number(v->x), ", ", number(v->y), ", ", number(v->z), "]"); },
+            [&](std::string* v) { return quoted(*v); },
+            [&](PinSpec* v) {
+                std::string preset = quoted(kPinPresetNames[static_cast<int>(v->preset)]);
+                if (v->particles.empty()) return preset;
+                std::string list;
+                for (const auto& [r, c] : v->particles) {
+                    list += cat(list.empty() ? "" : ", ", "[", std::to_string(r), ", ", std::to_string(c), "]");
+                }
+                return cat("{ preset = ", preset, ", particles = [", list, "] }");
+            },
+            [&](WindModel* v) { return quoted(kWindModelNames[static_cast<int>(*v)]); },
+        },
+        field.ref(s));
+}
+
+void validate(const Scene& scene) {
+    Scene& s = const_cast<Scene&>(scene);  // read only, see format_value
+    for (const FieldInfo& f : kFields) {
+        auto fail = [&] {
+            throw SceneError(std::string(f.name) + " = " + format_value(scene, f) + " is out of range; allowed: " +
+                             describe_allowed(f));
+        };
+        auto in_range = [&](double v) { return std::isfinite(v) && v >= f.min && v <= f.max; };
+        std::visit(Overloaded{
+                       [&](int* v) { if (!in_range(*v)) fail(); },
+                       [&](float* v) { if (!in_range(*v)) fail(); },
+                       [&](glm::vec2* v) { if (!in_range(v->x) || !in_range(v->y)) fail(); },
+                       [&](glm::vec3* v) { if (!in_range(v->x) || !in_range(v->y) || !in_range(v->z)) fail(); },
+                       [&](auto*) {},
+                   },
+                   f.ref(s));
+    }
+    const ClothSettings& c = scene.cloth;
+    if (static_cast<long long>(c.rows) * c.cols > kMaxParticles) {
+        throw SceneError("cloth.rows x cloth.cols = " + std::to_string(static_cast<long long>(c.rows) * c.cols) +
+                         " particles is too many; allowed: at most " + std::to_string(kMaxParticles));
+    }
+    const float lu = glm::length(c.u_axis), lv = glm::length(c.v_axis);
+    if (!(lu > 1e-6f)) throw SceneError("cloth.u_axis = " + format_value(scene, *find_field("cloth.u_axis")) + " has no direction; allowed: a non-zero vector");
+    if (!(lv > 1e-6f)) throw SceneError("cloth.v_axis = " + format_value(scene, *find_field("cloth.v_axis")) + " has no direction; allowed: a non-zero vector");
+    if (glm::length(glm::cross(c.u_axis / lu, c.v_axis / lv)) < 1e-3f) {
+        throw SceneError("cloth.u_axis and cloth.v_axis are parallel; allowed: two non-parallel directions");
+    }
+    for (const auto& [r, col] : scene.pins.particles) {
+        if (r < 0 || r >= c.rows || col < 0 || col >= c.cols) {
+            throw SceneError("pins: particle [" + std::to_string(r) + ", " + std::to_string(col) +
+                             "] is outside the " + std::to_string(c.rows) + " x " + std::to_string(c.cols) +
+                             " grid; allowed: row in [0, " + std::to_string(c.rows - 1) + "], col in [0, " +
+                             std::to_string(c.cols - 1) + "]");
+        }
+    }
+}
+
+}  // namespace clothsim

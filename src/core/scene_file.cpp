@@ -1,0 +1,343 @@
+// Scene files (TOML, read with toml++) and `--set key=value` overrides, both checked against the field
+// table (scene_fields.cpp) so a bad value is reported with its source, line, field and allowed range.
+#include "clothsim/scene.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#ifndef CLOTHSIM_DEFAULT_SCENE_DIR
+#define CLOTHSIM_DEFAULT_SCENE_DIR "assets/scenes"
+#endif
+
+namespace clothsim {
+namespace {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+    using Ts::operator()...;
+};
+
+std::string show(const toml::node& node) {
+    std::ostringstream os;
+    node.visit([&](const auto& n) { os << n; });
+    std::string s = os.str();
+    if (s.size() > 60) s = s.substr(0, 57) + "...";
+    return s;
+}
+
+std::optional<double> number_of(const toml::node& node) {
+    if (node.is_integer()) return static_cast<double>(node.as_integer()->get());
+    if (node.is_floating_point()) return node.as_floating_point()->get();
+    return std::nullopt;
+}
+
+// Reads `count` numbers from an array node; nullopt when it is not exactly that.
+std::optional<std::vector<double>> numbers_of(const toml::node& node, std::size_t count) {
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != count) return std::nullopt;
+    std::vector<double> out;
+    for (const toml::node& item : *array) {
+        const auto v = number_of(item);
+        if (!v) return std::nullopt;
+        out.push_back(*v);
+    }
+    return out;
+}
+
+template <class Enum>
+std::optional<Enum> enum_of(const toml::node& node, std::span<const std::string_view> names) {
+    const auto text = node.value<std::string>();
+    if (!text) return std::nullopt;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (names[i] == *text) return static_cast<Enum>(i);
+    }
+    return std::nullopt;
+}
+
+std::optional<std::vector<std::pair<int, int>>> pin_list_of(const toml::node& node) {
+    const toml::array* array = node.as_array();
+    if (!array) return std::nullopt;
+    std::vector<std::pair<int, int>> out;
+    for (const toml::node& item : *array) {
+        const toml::array* pair = item.as_array();
+        if (!pair || pair->size() != 2 || !(*pair)[0].is_integer() || !(*pair)[1].is_integer()) return std::nullopt;
+        out.emplace_back(static_cast<int>((*pair)[0].as_integer()->get()),
+                         static_cast<int>((*pair)[1].as_integer()->get()));
+    }
+    return out;
+}
+
+std::optional<PinSpec> pins_of(const toml::node& node) {
+    PinSpec spec;
+    if (auto preset = enum_of<PinPreset>(node, pin_preset_names())) {
+        spec.preset = *preset;
+        return spec;
+    }
+    if (auto list = pin_list_of(node)) {
+        spec.preset = PinPreset::None;
+        spec.particles = *list;
+        return spec;
+    }
+    if (const toml::table* table = node.as_table()) {
+        spec.preset = PinPreset::None;
+        for (auto&& [key, value] : *table) {
+            if (key.str() == "preset") {
+                auto preset = enum_of<PinPreset>(value, pin_preset_names());
+                if (!preset) return std::nullopt;
+                spec.preset = *preset;
+            } else if (key.str() == "particles") {
+                auto list = pin_list_of(value);
+                if (!list) return std::nullopt;
+                spec.particles = *list;
+            } else {
+                return std::nullopt;
+            }
+        }
+        return spec;
+    }
+    return std::nullopt;
+}
+
+// Sets one field from a TOML node. Returns false (and leaves the scene alone) when the node's type or
+// value is not allowed; validate() checks cross-field rules afterwards.
+bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
+    auto in_range = [&](double v) { return std::isfinite(v) && v >= field.min && v <= field.max; };
+    return std::visit(
+        Overloaded{
+            [&](int* target) {
+                if (!node.is_integer()) return false;
+                const auto v = node.as_integer()->get();
+                if (!in_range(static_cast<double>(v))) return false;
+                *target = static_cast<int>(v);
+                return true;
+            },
+            [&](float* target) {
+                const auto v = number_of(node);
+                if (!v || !in_range(*v)) return false;
+                *target = static_cast<float>(*v);
+                return true;
+            },
+            [&](bool* target) {
+                if (!node.is_boolean()) return false;
+                *target = node.as_boolean()->get();
+                return true;
+            },
+            [&](glm::vec2* target) {
+                if (const auto v = number_of(node)) {
+                    if (!in_range(*v)) return false;
+                    *target = glm::vec2(static_cast<float>(*v));
+                    return true;
+                }
+                const auto v = numbers_of(node, 2);
+                if (!v || !std::all_of(v->begin(), v->end(), in_range)) return false;
+                *target = glm::vec2((*v)[0], (*v)[1]);
+                return true;
+            },
+            [&](glm::vec3* target) {
+                const auto v = numbers_of(node, 3);
+                if (!v || !std::all_of(v->begin(), v->end(), in_range)) return false;
+                *target = glm::vec3((*v)[0], (*v)[1], (*v)[2]);
+                return true;
+            },
+            [&](std::string* target) {
+                const auto v = node.value<std::string>();
+                if (!v || !node.is_string()) return false;
+                *target = *v;
+                return true;
+            },
+            [&](PinSpec* target) {
+                const auto v = pins_of(node);
+                if (!v) return false;
+                *target = *v;
+                return true;
+            },
+            [&](WindModel* target) {
+                const auto v = enum_of<WindModel>(node, wind_model_names());
+                if (!v) return false;
+                *target = *v;
+                return true;
+            },
+        },
+        field.ref(scene));
+}
+
+std::string where(std::string_view source, const toml::node& node) {
+    const auto& begin = node.source().begin;
+    std::string s(source);
+    if (begin.line > 0) s += ":" + std::to_string(begin.line) + ":" + std::to_string(begin.column);
+    return s;
+}
+
+bool is_section(std::string_view prefix) {
+    const std::string dotted = std::string(prefix) + ".";
+    for (const FieldInfo& f : scene_fields()) {
+        if (f.name.starts_with(dotted)) return true;
+    }
+    return false;
+}
+
+std::string fields_in(std::string_view section) {
+    std::vector<std::string> names;
+    const std::string dotted = section.empty() ? "" : std::string(section) + ".";
+    for (const FieldInfo& f : scene_fields()) {
+        if (!f.name.starts_with(dotted)) continue;
+        std::string_view rest = f.name.substr(dotted.size());
+        std::string first(rest.substr(0, rest.find('.')));
+        if (std::find(names.begin(), names.end(), first) == names.end()) names.push_back(first);
+    }
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    return list;
+}
+
+void load_table(Scene& scene, const toml::table& table, const std::string& prefix, std::string_view source) {
+    for (auto&& [key, node] : table) {
+        const std::string name = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+        if (const FieldInfo* field = find_field(name)) {
+            if (!assign(scene, *field, node)) {
+                throw SceneError(where(source, node) + ": " + name + " = " + show(node) + " is not allowed; allowed: " +
+                                 describe_allowed(*field));
+            }
+        } else if (is_section(name)) {
+            const toml::table* sub = node.as_table();
+            if (!sub) {
+                throw SceneError(where(source, node) + ": " + name + " is a section, not a value; its fields: " +
+                                 fields_in(name));
+            }
+            load_table(scene, *sub, name, source);
+        } else {
+            throw SceneError(where(source, node) + ": unknown field '" + name + "'; known " +
+                             (prefix.empty() ? std::string("top-level names") : "fields of [" + prefix + "]") + ": " +
+                             fields_in(prefix));
+        }
+    }
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view toml_text, std::string_view source_name) {
+    toml::table table;
+    try {
+        table = toml::parse(toml_text, source_name);
+    } catch (const toml::parse_error& e) {
+        const auto& begin = e.source().begin;
+        throw SceneError(std::string(source_name) + ":" + std::to_string(begin.line) + ":" +
+                         std::to_string(begin.column) + ": TOML syntax error: " + std::string(e.description()));
+    }
+    Scene scene;
+    load_table(scene, table, "", source_name);
+    try {
+        validate(scene);
+    } catch (const SceneError& e) {
+        throw SceneError(std::string(source_name) + ": " + e.what());
+    }
+    return scene;
+}
+
+Scene load_scene_file(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw SceneError("cannot read scene file '" + path.string() + "': " + std::strerror(errno));
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw SceneError("cannot read scene file '" + path.string() + "'");
+    return parse_scene(text.str(), path.string());
+}
+
+std::filesystem::path scene_directory() {
+    if (const char* dir = std::getenv("CLOTHSIM_SCENES"); dir && *dir) return dir;
+    return CLOTHSIM_DEFAULT_SCENE_DIR;
+}
+
+std::vector<std::string> bundled_scene_names() {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(scene_directory(), ec)) {
+        if (entry.path().extension() == ".toml") names.push_back(entry.path().stem().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+Scene load_scene(std::string_view name_or_path) {
+    const std::filesystem::path as_path(name_or_path);
+    const bool looks_like_path = name_or_path.find('/') != std::string_view::npos || as_path.extension() == ".toml";
+    if (looks_like_path) return load_scene_file(as_path);
+    const std::filesystem::path bundled = scene_directory() / (std::string(name_or_path) + ".toml");
+    if (std::filesystem::exists(bundled)) return load_scene_file(bundled);
+    std::string names;
+    for (const std::string& n : bundled_scene_names()) names += (names.empty() ? "" : ", ") + n;
+    throw SceneError("unknown scene '" + std::string(name_or_path) + "'; bundled scenes: " +
+                     (names.empty() ? "(none found in " + scene_directory().string() + ")" : names) +
+                     "; or give the path of a .toml file");
+}
+
+void apply_override(Scene& scene, std::string_view assignment) {
+    const std::string source = "--set " + std::string(assignment);
+    const auto eq = assignment.find('=');
+    if (eq == std::string_view::npos || eq == 0) {
+        throw SceneError(source + ": expected key=value, e.g. --set cloth.rows=64");
+    }
+    const std::string key(assignment.substr(0, eq));
+    const std::string text(assignment.substr(eq + 1));
+    const FieldInfo* field = find_field(key);
+    if (!field) {
+        throw SceneError(source + ": unknown field '" + key + "'; fields: " + [] {
+            std::string all;
+            for (const FieldInfo& f : scene_fields()) all += (all.empty() ? "" : ", ") + std::string(f.name);
+            return all;
+        }());
+    }
+    // The value is TOML when it parses as one; otherwise it is taken as a bare string (top-row, uniform).
+    std::optional<toml::table> parsed;
+    try {
+        parsed = toml::parse("value = " + text);
+    } catch (const toml::parse_error&) {
+    }
+    const toml::value<std::string> bare(text);
+    const toml::node& node = parsed && parsed->contains("value") ? *parsed->get("value")
+                                                                    : static_cast<const toml::node&>(bare);
+    Scene candidate = scene;
+    if (!assign(candidate, *field, node)) {
+        throw SceneError(source + ": " + key + " = " + show(node) + " is not allowed; allowed: " +
+                         describe_allowed(*field));
+    }
+    try {
+        validate(candidate);
+    } catch (const SceneError& e) {
+        throw SceneError(source + ": " + e.what());
+    }
+    scene = std::move(candidate);
+}
+
+std::string to_toml(const Scene& scene) {
+    std::string out = "# clothsim scene (fields, units and ranges: README.md, \"Scene files\")\n";
+    for (const FieldInfo& f : scene_fields()) {
+        if (f.name.find('.') == std::string_view::npos) {
+            out += std::string(f.name) + " = " + format_value(scene, f) + "\n";
+        }
+    }
+    std::string section;
+    for (const FieldInfo& f : scene_fields()) {
+        const auto dot = f.name.rfind('.');
+        if (dot == std::string_view::npos) continue;
+        const std::string s(f.name.substr(0, dot));
+        if (s != section) {
+            section = s;
+            out += "\n[" + section + "]\n";
+        }
+        out += std::string(f.name.substr(dot + 1)) + " = " + format_value(scene, f) + "\n";
+    }
+    return out;
+}
+
+}  // namespace clothsim

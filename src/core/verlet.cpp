@@ -1,0 +1,54 @@
+#include "verlet.hpp"
+
+namespace clothsim {
+
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h) {
+    const float half_ch = 0.5f * damping * h;
+    const float keep = 1.0f - damping * h / (1.0f + half_ch);  // 1 - d
+    const float h2 = h * h / (1.0f + half_ch);
+    const std::size_t n = state.size();
+    Vec3Array& x = state.position;
+    Vec3Array& xp = state.previous_position;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state.pinned[i]) {
+            xp.set(i, x.get(i));
+            continue;
+        }
+        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
+        const glm::vec3 xi = x.get(i);
+        x.set(i, xi + (xi - xp.get(i)) * keep + a * h2);
+        xp.set(i, xi);
+    }
+    state.substep = h;
+}
+
+void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
+                  glm::vec3 gravity, float damping, float h) {
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        const glm::vec3 x = state.position.get(i);
+        if (state.pinned[i]) {
+            state.previous_position.set(i, x);
+            continue;
+        }
+        const glm::vec3 v = velocity[i];
+        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity - damping * v;
+        state.previous_position.set(i, x - v * h + a * (0.5f * h * h));
+    }
+    state.substep = h;
+}
+
+std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
+                                         float damping) {
+    const float h = state.substep;
+    std::vector<glm::vec3> v(state.size(), glm::vec3(0.0f));
+    if (!(h > 0.0f)) return v;
+    const float scale = 1.0f / (1.0f + 0.5f * damping * h);
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        if (state.pinned[i]) continue;
+        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
+        v[i] = ((state.position.get(i) - state.previous_position.get(i)) / h + a * (0.5f * h)) * scale;
+    }
+    return v;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,31 @@
+// Position Verlet with physical-unit damping.
+//
+// The model is x'' = a - c x' (a = F/m + g, c the damping rate in 1/s). Central differences,
+//   (x' - 2x + x_prev) / h^2 = a - c (x' - x_prev) / (2h),
+// give x' = [2x - (1 - c h/2) x_prev + a h^2] / (1 + c h/2), which is the seed's form
+//   x' = x + (x - x_prev)(1 - d) + a h^2 / (1 + c h/2)   with   d = c h / (1 + c h/2).
+// d is derived from c and h each step, so the damping a user sees does not change when h changes, and the
+// scheme stays second order with damping on.
+#pragma once
+
+#include "clothsim/state.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <vector>
+
+namespace clothsim {
+
+// One substep of length h for every free particle; pinned particles stay where they are.
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h);
+
+// Second-order start: x_prev = x - v h + (a - c v) h^2 / 2, with a = F/m + g at x. Sets state.substep = h.
+void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
+                  glm::vec3 gravity, float damping, float h);
+
+// Second-order velocity at the current positions, from the Taylor expansion of x_prev around x:
+//   v (1 + c h/2) = (x - x_prev) / h + a h / 2.
+std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
+                                         float damping);
+
+}  // namespace clothsim

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <charconv>
 #include <cstdio>
 #include <sstream>
 
@@ -64,10 +65,11 @@ constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corner
                                                              "left-edge"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 
+// Shortest text that reads back to the same float (std::to_chars), so 0.2f prints as 0.2, not 0.200000003.
 std::string number(double v) {
     char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.9g", v);
-    std::string s = buffer;
+    const auto result = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(v));
+    std::string s(buffer, result.ptr);
     // Keep TOML floats floats: "1" would read back as an integer.
     if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
     return s;

@@ -50,12 +50,18 @@ struct Topology {
 
 struct State {
     Vec3Array position;           // m
-    Vec3Array previous_position;  // m, one substep of length `substep` ago
+    // m: x - x_prev, the motion of the last substep. Position Verlet's previous positions are x - motion.
+    // Keeping the difference instead of x_prev is the same scheme with less round-off: in float, x_prev
+    // loses the small per-step motion to x's rounding and the velocity error then grows every step
+    // (measured on a 2-particle oscillator at 800 substeps per period over 3 periods: max error 4.4e-5 m
+    // with x_prev, 2.4e-6 m with motion; 2.0e-4 m and 1.4e-6 m with damping 2/s). Stored motion keeps
+    // full relative precision.
+    Vec3Array motion;
     std::vector<float> mass;      // kg (kept for pinned particles too, for energy and momentum)
     std::vector<float> inverse_mass;  // 1/kg, 0 for pinned particles
     std::vector<std::uint8_t> pinned;
     double time = 0.0;            // s
-    float substep = 0.0f;         // s: the step previous_position belongs to
+    float substep = 0.0f;         // s: the substep `motion` belongs to
 
     std::size_t size() const { return position.size(); }
 };

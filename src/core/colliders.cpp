@@ -55,17 +55,18 @@ template <class Shape>
 void collide_shape(State& state, const Shape& shape, float friction, float thickness) {
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
-        glm::vec3 x = state.position.get(i);
-        const Contact c = contact(shape, x, thickness);
+        const Contact c = contact(shape, state.position.get(i), thickness);
         if (!(c.depth > 0.0f)) continue;
-        x += c.normal * c.depth;
+        glm::vec3 correction = c.normal * c.depth;
         if (friction > 0.0f) {
-            const glm::vec3 step = x - state.previous_position.get(i);
+            const glm::vec3 step = state.motion.get(i) + correction;  // x' - x_prev after the push
             const glm::vec3 tangential = step - glm::dot(step, c.normal) * c.normal;
             const float slide = glm::length(tangential);
-            if (slide > 0.0f) x -= tangential * (std::min(slide, friction * c.depth) / slide);
+            if (slide > 0.0f) correction -= tangential * (std::min(slide, friction * c.depth) / slide);
         }
-        state.position.set(i, x);
+        // Moving x moves the substep's motion with it: x_prev stays where it was.
+        state.position.add(i, correction);
+        state.motion.add(i, correction);
     }
 }
 

@@ -41,7 +41,7 @@ void accumulate_wind_forces(const Topology& topology, const State& state, const 
     const glm::vec3 wind = wind_velocity(forces, state.time);
     const float inv_h = state.substep > 0.0f ? 1.0f / state.substep : 0.0f;
     auto velocity = [&](std::size_t i) {
-        return (state.position.get(i) - state.previous_position.get(i)) * inv_h;
+        return state.motion.get(i) * inv_h;
     };
     if (forces.wind_model == WindModel::Uniform) {
         const float area = rest_area / static_cast<float>(state.size());

@@ -24,7 +24,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
         rest_area_ += 0.5f * glm::length(glm::cross(state_.position.get(t[1]) - a, state_.position.get(t[2]) - a));
     }
     force_.resize(n);
-    state_.previous_position = state_.position;
+    state_.motion.resize(n);
     restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
             substep_length());
 }
@@ -79,7 +79,8 @@ void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
 }
 
 Particle MassSpring::particle(std::size_t i) const {
-    return {state_.position.get(i), state_.previous_position.get(i), state_.mass[i], state_.pinned[i] != 0};
+    const glm::vec3 x = state_.position.get(i);
+    return {x, x - state_.motion.get(i), state_.mass[i], state_.pinned[i] != 0};
 }
 
 std::vector<glm::vec3> MassSpring::positions() const {
@@ -130,7 +131,7 @@ bool MassSpring::all_finite() const {
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
     state_.pinned.at(i) = pinned ? 1 : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
-    if (pinned) state_.previous_position.set(i, state_.position.get(i));
+    if (pinned) state_.motion.set(i, glm::vec3(0.0f));
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {

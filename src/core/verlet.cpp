@@ -8,16 +8,16 @@ void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, f
     const float h2 = h * h / (1.0f + half_ch);
     const std::size_t n = state.size();
     Vec3Array& x = state.position;
-    Vec3Array& xp = state.previous_position;
+    Vec3Array& motion = state.motion;
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) {
-            xp.set(i, x.get(i));
+            motion.set(i, glm::vec3(0.0f));
             continue;
         }
         const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
-        const glm::vec3 xi = x.get(i);
-        x.set(i, xi + (xi - xp.get(i)) * keep + a * h2);
-        xp.set(i, xi);
+        const glm::vec3 step = motion.get(i) * keep + a * h2;  // x' - x = (x - x_prev)(1 - d) + a h^2/(1 + ch/2)
+        motion.set(i, step);
+        x.add(i, step);
     }
     state.substep = h;
 }
@@ -25,14 +25,13 @@ void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, f
 void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
                   glm::vec3 gravity, float damping, float h) {
     for (std::size_t i = 0; i < state.size(); ++i) {
-        const glm::vec3 x = state.position.get(i);
         if (state.pinned[i]) {
-            state.previous_position.set(i, x);
+            state.motion.set(i, glm::vec3(0.0f));
             continue;
         }
         const glm::vec3 v = velocity[i];
         const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity - damping * v;
-        state.previous_position.set(i, x - v * h + a * (0.5f * h * h));
+        state.motion.set(i, v * h - a * (0.5f * h * h));
     }
     state.substep = h;
 }
@@ -46,7 +45,7 @@ std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& fo
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
         const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
-        v[i] = ((state.position.get(i) - state.previous_position.get(i)) / h + a * (0.5f * h)) * scale;
+        v[i] = (state.motion.get(i) / h + a * (0.5f * h)) * scale;
     }
     return v;
 }

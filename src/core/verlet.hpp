@@ -19,12 +19,13 @@ namespace clothsim {
 // One substep of length h for every free particle; pinned particles stay where they are.
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h);
 
-// Second-order start: x_prev = x - v h + (a - c v) h^2 / 2, with a = F/m + g at x. Sets state.substep = h.
+// Second-order start: x - x_prev = v h - (a - c v) h^2 / 2, with a = F/m + g at x. Sets state.substep = h.
 void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
                   glm::vec3 gravity, float damping, float h);
 
 // Second-order velocity at the current positions, from the Taylor expansion of x_prev around x:
 //   v (1 + c h/2) = (x - x_prev) / h + a h / 2.
+// State keeps x - x_prev as `motion` (see state.hpp for why).
 std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
                                          float damping);
 

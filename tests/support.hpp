@@ -1,0 +1,25 @@
+// Small scene builders shared by the physics tests.
+#pragma once
+
+#include "clothsim/scene.hpp"
+
+namespace clothsim::test {
+
+// A vertical chain of `particles` particles spaced `spacing` apart hanging down from the origin, with only
+// structural springs of stiffness k, no gravity, no damping, no colliders, nothing pinned.
+inline Scene chain(int particles, float spacing, float particle_mass, float k) {
+    Scene s;
+    s.cloth.rows = particles;
+    s.cloth.cols = 1;
+    s.cloth.size = {1.0f, particles > 1 ? spacing * static_cast<float>(particles - 1) : 1.0f};
+    s.cloth.mass = particle_mass * static_cast<float>(particles);
+    s.cloth.origin = {0.0f, 0.0f, 0.0f};
+    s.pins.preset = PinPreset::None;
+    s.settings.springs = {k, 0.0f, 0.0f, 0.0f};
+    s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
+    s.settings.colliders.ground.enabled = false;
+    s.settings.integration.substeps = 1;
+    return s;
+}
+
+}  // namespace clothsim::test

@@ -14,7 +14,8 @@ Topology grid_topology(int rows, int cols, const Vec3Array& position) {
     t.rows = rows;
     t.cols = cols;
     auto add = [&](int r0, int c0, int r1, int c1, SpringKind kind) {
-        if (r1 < 0 || r1 >= rows || c1 < 0 || c1 >= cols) return;
+        auto inside = [&](int r, int c) { return r >= 0 && r < rows && c >= 0 && c < cols; };
+        if (!inside(r0, c0) || !inside(r1, c1)) return;
         const auto a = static_cast<std::uint32_t>(t.index(r0, c0));
         const auto b = static_cast<std::uint32_t>(t.index(r1, c1));
         t.springs.push_back({a, b, glm::length(position.get(b) - position.get(a)), kind});

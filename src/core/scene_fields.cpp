@@ -129,12 +129,21 @@ std::string describe_allowed(const FieldInfo& field) {
 std::string format_value(const Scene& scene, const FieldInfo& field) {
     // The table hands out mutable references; reading through one here changes nothing.
     Scene& s = const_cast<Scene&>(scene);
+    // A TOML basic string: quotes, backslashes and control characters escaped (TOML 1.0, "String").
     auto quoted = [](std::string_view text) {
         std::string out = "\"";
-        for (char c : text) {
-            if (c == '"' || c == '\\') out += '\\';
-            if (c == '\n') { out += "\\n"; continue; }
-            out += c;
+        for (const char c : text) {
+            const auto u = static_cast<unsigned char>(c);
+            if (c == '"' || c == '\\') {
+                out += '\\';
+                out += c;
+            } else if (u < 0x20 || u == 0x7f) {
+                char escape[8];
+                std::snprintf(escape, sizeof escape, "\\u%04X", u);
+                out += escape;
+            } else {
+                out += c;
+            }
         }
         return out + "\"";
     };
@@ -168,11 +177,15 @@ void validate(const Scene& scene) {
                              describe_allowed(f));
         };
         auto in_range = [&](double v) { return std::isfinite(v) && v >= f.min && v <= f.max; };
+        // Stored floats are compared with the bounds rounded to float: 1e-6 loads as 9.99999997e-7f.
+        auto in_float_range = [&](float v) {
+            return std::isfinite(v) && v >= static_cast<float>(f.min) && v <= static_cast<float>(f.max);
+        };
         std::visit(Overloaded{
                        [&](int* v) { if (!in_range(*v)) fail(); },
-                       [&](float* v) { if (!in_range(*v)) fail(); },
-                       [&](glm::vec2* v) { if (!in_range(v->x) || !in_range(v->y)) fail(); },
-                       [&](glm::vec3* v) { if (!in_range(v->x) || !in_range(v->y) || !in_range(v->z)) fail(); },
+                       [&](float* v) { if (!in_float_range(*v)) fail(); },
+                       [&](glm::vec2* v) { if (!in_float_range(v->x) || !in_float_range(v->y)) fail(); },
+                       [&](glm::vec3* v) { if (!in_float_range(v->x) || !in_float_range(v->y) || !in_float_range(v->z)) fail(); },
                        [&](auto*) {},
                    },
                    f.ref(s));

@@ -243,6 +243,10 @@ Scene parse_scene(std::string_view toml_text, std::string_view source_name) {
 }
 
 Scene load_scene_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw SceneError("cannot read scene file '" + path.string() + "': it is a directory");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         throw SceneError("cannot read scene file '" + path.string() + "': " + std::strerror(errno));

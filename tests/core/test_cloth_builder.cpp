@@ -1,1 +1,114 @@
+// The cloth builder: grid placement along the axes, spring counts and rest lengths per kind, mass, triangles.
+#include "support.hpp"
+
 #include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <set>
+
+using namespace clothsim;
+
+TEST_CASE("cloth_builder places rows x cols particles along the two axes", "[cloth_builder]") {
+    Scene s;
+    s.cloth.rows = 4;
+    s.cloth.cols = 6;
+    s.cloth.size = {2.5f, 1.5f};
+    s.cloth.origin = {1.0f, 2.0f, 3.0f};
+    s.cloth.u_axis = {0.0f, 0.0f, 2.0f};  // normalised by the builder
+    s.cloth.v_axis = {-3.0f, 0.0f, 0.0f};
+    const MassSpring sim = build_simulation(s);
+    REQUIRE(sim.particle_count() == 24);
+    CHECK(sim.position(0) == glm::vec3(1.0f, 2.0f, 3.0f));
+    const glm::vec3 last = sim.position(23);  // row 3, col 5
+    CHECK(last.x == Approx(1.0f - 1.5f));
+    CHECK(last.y == Approx(2.0f));
+    CHECK(last.z == Approx(3.0f + 2.5f));
+    CHECK(sim.position(s.cloth.cols).x == Approx(1.0f - 0.5f));  // row 1, col 0
+    double mass = 0.0;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) mass += sim.particle(i).mass;
+    CHECK(mass == Approx(s.cloth.mass));
+    CHECK(sim.rest_area() == Approx(2.5f * 1.5f));
+}
+
+TEST_CASE("cloth_builder makes structural, shear and bending springs with their rest lengths", "[cloth_builder]") {
+    for (auto [rows, cols] : {std::pair{5, 7}, std::pair{1, 9}, std::pair{9, 1}, std::pair{2, 2}, std::pair{1, 1}}) {
+        Scene s;
+        s.cloth.rows = rows;
+        s.cloth.cols = cols;
+        s.cloth.size = {1.2f, 0.8f};
+        const MassSpring sim = build_simulation(s);
+        const Topology& t = sim.topology();
+        const auto count = [&](SpringKind k) { return t.spring_count_by_kind[static_cast<int>(k)]; };
+        INFO(rows << " x " << cols);
+        CHECK(count(SpringKind::Structural) == std::size_t(rows * (cols - 1) + (rows - 1) * cols));
+        CHECK(count(SpringKind::Shear) == std::size_t(2 * (rows - 1) * (cols - 1)));
+        CHECK(count(SpringKind::Bending) ==
+              std::size_t(rows * std::max(cols - 2, 0) + std::max(rows - 2, 0) * cols));
+        CHECK(t.springs.size() == count(SpringKind::Structural) + count(SpringKind::Shear) + count(SpringKind::Bending));
+        CHECK(t.triangles.size() == std::size_t(2 * (rows - 1) * (cols - 1)));
+
+        const float du = cols > 1 ? 1.2f / float(cols - 1) : 0.0f;
+        const float dv = rows > 1 ? 0.8f / float(rows - 1) : 0.0f;
+        std::set<std::pair<std::uint32_t, std::uint32_t>> seen;
+        for (const Spring& sp : t.springs) {
+            CHECK(sp.a != sp.b);
+            CHECK(seen.insert({std::min(sp.a, sp.b), std::max(sp.a, sp.b)}).second);  // no duplicates
+            const int dr = std::abs(int(sp.a) / cols - int(sp.b) / cols);
+            const int dc = std::abs(int(sp.a) % cols - int(sp.b) % cols);
+            const float expected = std::sqrt((dc * du) * (dc * du) + (dr * dv) * (dr * dv));
+            CHECK(sp.rest_length == Approx(expected));
+            CHECK(sp.rest_length == Approx(glm::length(sim.position(sp.a) - sim.position(sp.b))));
+            switch (sp.kind) {
+                case SpringKind::Structural: CHECK(dr + dc == 1); break;
+                case SpringKind::Shear: CHECK((dr == 1 && dc == 1)); break;
+                case SpringKind::Bending: CHECK(((dr == 2 && dc == 0) || (dr == 0 && dc == 2))); break;
+            }
+        }
+    }
+}
+
+TEST_CASE("cloth_builder winds every triangle with normal u_axis x v_axis", "[cloth_builder]") {
+    Scene s;
+    s.cloth.rows = 3;
+    s.cloth.cols = 4;
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};  // lying flat: normal (1,0,0) x (0,0,1) = (0,-1,0)
+    const MassSpring sim = build_simulation(s);
+    for (const auto& tri : sim.topology().triangles) {
+        const glm::vec3 a = sim.position(tri[0]);
+        const glm::vec3 n = glm::normalize(glm::cross(sim.position(tri[1]) - a, sim.position(tri[2]) - a));
+        CHECK(n.y == Approx(-1.0f));
+    }
+}
+
+TEST_CASE("cloth_builder pins and inverse masses", "[cloth_builder]") {
+    Scene s;
+    s.cloth.rows = 3;
+    s.cloth.cols = 3;
+    s.pins.preset = PinPreset::TopRow;
+    s.pins.particles = {{2, 2}};
+    const MassSpring sim = build_simulation(s);
+    for (std::size_t i = 0; i < 9; ++i) {
+        const bool pinned = i < 3 || i == 8;
+        CHECK(sim.particle(i).pinned == pinned);
+        CHECK(sim.state().inverse_mass[i] == (pinned ? 0.0f : 1.0f / sim.particle(i).mass));
+    }
+}
+
+TEST_CASE("cloth_builder rejects what it cannot build with a message", "[cloth_builder]") {
+    Scene s;
+    s.cloth.u_axis = {0.0f, 1.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, -2.0f, 0.0f};
+    CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("parallel"));
+    s = Scene{};
+    s.cloth.rows = 2048;
+    s.cloth.cols = 2048;
+    CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("too many") && Catch::Contains("1048576"));
+    s = Scene{};
+    s.cloth.mass = -1.0f;
+    CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("cloth.mass"));
+    s = Scene{};
+    s.pins.particles = {{40, 0}};
+    CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("outside the 32 x 32 grid"));
+}

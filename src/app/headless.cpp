@@ -43,6 +43,10 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
         std::cerr << "clothsim: error: --obj " << options.obj << ": the directory does not exist\n";
         return kExitBadInput;
     }
+    if (!options.obj.empty() && std::filesystem::is_directory(options.obj)) {
+        std::cerr << "clothsim: error: --obj " << options.obj << ": is a directory, not a file name\n";
+        return kExitBadInput;
+    }
 
     const auto start = std::chrono::steady_clock::now();
     long long done = 0;

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #ifndef CLOTHSIM_DEFAULT_SCENE_DIR
 #define CLOTHSIM_DEFAULT_SCENE_DIR "assets/scenes"
@@ -237,7 +238,12 @@ Scene parse_scene(std::string_view toml_text, std::string_view source_name) {
     try {
         validate(scene);
     } catch (const SceneError& e) {
-        throw SceneError(std::string(source_name) + ": " + e.what());
+        // Cross-field messages start with the field they blame ("pins: ...", "cloth.u_axis and ..."): point
+        // at that field's line when the file sets it.
+        const std::string message = e.what();
+        const std::string field = message.substr(0, message.find_first_of(" :"));
+        const toml::node_view<const toml::node> node = std::as_const(table).at_path(field);
+        throw SceneError((node ? where(source_name, *node.node()) : std::string(source_name)) + ": " + message);
     }
     return scene;
 }

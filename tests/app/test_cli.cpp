@@ -1,1 +1,471 @@
+// The clothsim executable, run as a user would: flags, exit codes (0 ok, 2 bad input, 3 non-finite), the
+// --json report, the trajectory CSV and the OBJ mesh.
+#include "clothsim/scene.hpp"
+
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = CLOTHSIM_TEST_DATA;
+
+struct RunResult {
+    int code = -1;
+    std::string out;  // stdout
+    std::string err;  // stderr
+};
+
+std::string quote(const std::string& arg) {
+    std::string q = "'";
+    for (char c : arg) {
+        if (c == '\'') q += "'\\''";
+        else q += c;
+    }
+    return q + "'";
+}
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A fresh directory for one test's files, removed when the test ends.
+class TempDir {
+public:
+    explicit TempDir(const std::string& name)
+        : path_(fs::temp_directory_path() / ("clothsim_test_" + std::to_string(::getpid()) + "_" + name)) {
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const fs::path& path() const { return path_; }
+    fs::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+    fs::path path_;
+};
+
+// Runs the clothsim executable with `args`; stdout is captured through the pipe, stderr through a file.
+RunResult run_clothsim(const std::vector<std::string>& args) {
+    static int counter = 0;
+    const fs::path err_file =
+        fs::temp_directory_path() /
+        ("clothsim_test_" + std::to_string(::getpid()) + "_stderr_" + std::to_string(counter++) + ".txt");
+    std::string command = quote(CLOTHSIM_EXE);
+    // Appends, not "literal" + string: GCC 12 warns falsely on that (-Wrestrict, GCC bug 105329).
+    for (const std::string& a : args) command.append(" ").append(quote(a));
+    command.append(" 2>").append(quote(err_file.string()));
+
+    RunResult result;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    REQUIRE(pipe != nullptr);
+    char buffer[4096];
+    std::size_t n;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.out.append(buffer, n);
+    const int status = ::pclose(pipe);
+    REQUIRE(WIFEXITED(status));
+    result.code = WEXITSTATUS(status);
+    result.err = read_file(err_file);
+    std::error_code ec;
+    fs::remove(err_file, ec);
+    return result;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+    std::vector<std::string> parts;
+    std::string part;
+    std::istringstream in(line);
+    while (std::getline(in, part, sep)) parts.push_back(part);
+    if (!line.empty() && line.back() == sep) parts.push_back("");
+    return parts;
+}
+
+bool is_finite_number(const std::string& text) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        return false;
+    }
+    return used == text.size() && std::isfinite(v);
+}
+
+// A failed run shows what the program said.
+#define CAPTURE_RUN(r) INFO("exit code " << (r).code << "\nstdout:\n" << (r).out << "\nstderr:\n" << (r).err)
+
+// Runs expecting exit code 2 (bad input) and a message on stderr with every one of `needles`.
+void expect_bad_input(const std::vector<std::string>& args, std::initializer_list<std::string> needles) {
+    std::string joined;
+    for (const std::string& a : args) joined += " " + a;
+    INFO("clothsim" << joined);
+    const RunResult r = run_clothsim(args);
+    CAPTURE_RUN(r);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("clothsim: error:"));
+    for (const std::string& needle : needles) CHECK_THAT(r.err, Contains(needle));
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+// --json
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("cli: --headless --json prints only a JSON report on stdout") {
+    const RunResult r = run_clothsim({"--headless", "--scene", "drape-sphere", "--duration", "3", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK(r.err.empty());
+    REQUIRE(nlohmann::json::accept(r.out));
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    REQUIRE(j.is_object());
+    CHECK(j.at("scene") == "drape-sphere");
+    CHECK(j.at("particles") == 1600);
+    REQUIRE(j.at("springs").is_number_integer());
+    CHECK(j.at("springs").get<long long>() > 0);
+    CHECK(j.at("steps") == 180);
+    REQUIRE(j.at("simulated_seconds").is_number());
+    CHECK(j.at("simulated_seconds").get<double>() == Approx(3.0).margin(1e-3));
+    REQUIRE(j.at("wall_seconds").is_number());
+    CHECK(j.at("wall_seconds").get<double>() > 0.0);
+    CHECK(j.at("finite") == true);
+    CHECK(j.at("kinetic_energy").is_number());
+    CHECK(j.at("potential_energy").is_number());
+    CHECK(j.at("total_energy").is_number());
+    CHECK(std::isfinite(j.at("kinetic_energy").get<double>()));
+    CHECK(std::isfinite(j.at("potential_energy").get<double>()));
+    CHECK(j.at("kinetic_energy").get<double>() >= 0.0);
+}
+
+TEST_CASE("cli: --set changes the scene that is run") {
+    const RunResult r = run_clothsim(
+        {"--headless", "--set", "cloth.rows=8", "--set", "cloth.cols=6", "--steps", "3", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    CHECK(j.at("particles") == 48);
+    CHECK(j.at("steps") == 3);
+    CHECK(j.at("scene") == "hanging");  // the default scene
+    CHECK(j.at("finite") == true);
+}
+
+TEST_CASE("cli: a scene given as a path to a .toml file is run") {
+    const RunResult r = run_clothsim(
+        {"--headless", "--scene", (kData / "scene_small.toml").string(), "--steps", "10", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    CHECK(j.at("scene") == "small");
+    CHECK(j.at("particles") == 6);
+    CHECK(j.at("steps") == 10);
+    CHECK(j.at("simulated_seconds").get<double>() == Approx(0.1).margin(1e-6));
+    CHECK(j.at("substeps_per_step") == 10);
+}
+
+TEST_CASE("cli: the text report of a headless run") {
+    const RunResult r = run_clothsim({"--headless", "--scene", "flag", "--steps", "2"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("scene flag: 864 particles"));
+    CHECK_THAT(r.out, Contains("ran 2 steps"));
+    CHECK_THAT(r.out, Contains("finite: yes"));
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Bad input: exit code 2 and a message naming the problem
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("cli: an unknown scene exits 2 and lists the bundled scenes") {
+    expect_bad_input({"--headless", "--scene", "no-such-scene"},
+                     {"unknown scene", "no-such-scene", "curtain", "drape-cube", "drape-sphere", "falling", "flag",
+                      "hanging"});
+}
+
+TEST_CASE("cli: a bad --set exits 2 and names the field") {
+    expect_bad_input({"--headless", "--set", "cloth.rowz=3"}, {"--set cloth.rowz=3", "unknown field 'cloth.rowz'"});
+    expect_bad_input({"--headless", "--set", "cloth.rows=-3"}, {"--set cloth.rows=-3", "cloth.rows", "[1, 2048]"});
+    expect_bad_input({"--headless", "--set", "cloth.mass=heavy"}, {"cloth.mass", "kg"});
+    expect_bad_input({"--headless", "--set", "cloth.rows"}, {"--set cloth.rows", "expected key=value"});
+}
+
+TEST_CASE("cli: an unknown flag exits 2") {
+    expect_bad_input({"--headless", "--bogus"}, {"--bogus", "--help"});
+}
+
+TEST_CASE("cli: a negative or zero --duration exits 2") {
+    expect_bad_input({"--headless", "--duration", "-1"}, {"--duration"});
+    expect_bad_input({"--headless", "--duration", "0"}, {"--duration"});
+    expect_bad_input({"--headless", "--steps", "-4"}, {"--steps"});
+}
+
+TEST_CASE("cli: --duration together with --steps exits 2") {
+    expect_bad_input({"--headless", "--duration", "1", "--steps", "10"}, {"--duration", "--steps"});
+}
+
+TEST_CASE("cli: a malformed scene file exits 2 with its file and line") {
+    const std::string path = (kData / "scene_bad_range.toml").string();
+    expect_bad_input({"--headless", "--scene", path}, {path + ":7:", "cloth.rows", "[1, 2048]"});
+    const std::string syntax = (kData / "scene_bad_syntax.toml").string();
+    expect_bad_input({"--headless", "--scene", syntax}, {syntax + ":5:", "TOML syntax error"});
+    const std::string missing = (kData / "no_such_scene.toml").string();
+    expect_bad_input({"--headless", "--scene", missing}, {"cannot read scene file", missing});
+}
+
+TEST_CASE("cli: --every without --trajectory exits 2") {
+    expect_bad_input({"--headless", "--every", "5"}, {"--every", "--trajectory"});
+}
+
+TEST_CASE("cli: --every 0 exits 2") {
+    const TempDir dir("every0");
+    expect_bad_input({"--headless", "--trajectory", (dir / "t.csv").string(), "--every", "0"}, {"--every"});
+}
+
+TEST_CASE("cli: --trajectory into a missing directory exits 2") {
+    const TempDir dir("trajectory_missing");
+    const std::string path = (dir / "no_such_dir" / "out.csv").string();
+    expect_bad_input({"--headless", "--steps", "1", "--trajectory", path}, {path});
+    CHECK_FALSE(fs::exists(dir / "no_such_dir"));
+}
+
+TEST_CASE("cli: --obj into a missing directory exits 2") {
+    const TempDir dir("obj_missing");
+    const std::string path = (dir / "no_such_dir" / "out.obj").string();
+    expect_bad_input({"--headless", "--steps", "1", "--obj", path}, {"--obj", path, "does not exist"});
+    CHECK_FALSE(fs::exists(dir / "no_such_dir"));
+}
+
+TEST_CASE("cli: --obj naming a directory exits 2 before simulating") {
+    const TempDir dir("obj_directory");
+    const std::string path = dir.path().string();
+    expect_bad_input({"--headless", "--steps", "1", "--obj", path}, {"--obj", path, "is a directory"});
+}
+
+TEST_CASE("cli: running without --headless exits 2 and mentions --headless") {
+    expect_bad_input({}, {"--headless"});
+    expect_bad_input({"--scene", "flag", "--steps", "1"}, {"--headless"});
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Non-finite: exit code 3
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("cli: a simulation that blows up exits 3 and reports finite false") {
+    const std::vector<std::string> args = {"--headless", "--set", "springs.structural=1e9", "--set",
+                                           "integration.substeps=1", "--set", "integration.dt=0.1", "--steps", "50"};
+    SECTION("text") {
+        const RunResult r = run_clothsim(args);
+        CAPTURE_RUN(r);
+        CHECK(r.code == 3);
+        CHECK_THAT(r.err, Contains("non-finite"));
+        CHECK_THAT(r.err, Contains("integration.dt"));
+        CHECK_THAT(r.out, Contains("finite: no"));
+    }
+    SECTION("json") {
+        std::vector<std::string> with_json = args;
+        with_json.push_back("--json");
+        const RunResult r = run_clothsim(with_json);
+        CAPTURE_RUN(r);
+        CHECK(r.code == 3);
+        REQUIRE(nlohmann::json::accept(r.out));
+        const nlohmann::json j = nlohmann::json::parse(r.out);
+        CHECK(j.at("finite") == false);
+        // The run stops at the first non-finite step.
+        CHECK(j.at("steps").get<long long>() >= 1);
+        CHECK(j.at("steps").get<long long>() < 50);
+        CHECK(j.at("kinetic_energy").is_null());
+        CHECK_THAT(r.err, Contains("non-finite"));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Output files
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("cli: --trajectory with --every writes the recorded steps as CSV") {
+    const TempDir dir("trajectory");
+    const fs::path csv = dir / "out.csv";
+    const RunResult r = run_clothsim({"--headless", "--trajectory", csv.string(), "--every", "5", "--steps", "20",
+                                      "--set", "cloth.rows=3", "--set", "cloth.cols=2"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    REQUIRE(fs::exists(csv));
+    const std::vector<std::string> lines = lines_of(read_file(csv));
+    REQUIRE(lines.size() == 31);
+    CHECK(lines[0] == "step,time,particle,x,y,z");
+    const double dt = clothsim::Scene{}.settings.integration.dt;
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+        INFO("line " << i + 1 << ": " << lines[i]);
+        const std::vector<std::string> cells = split(lines[i], ',');
+        REQUIRE(cells.size() == 6);
+        const long long expected_step = static_cast<long long>((i - 1) / 6) * 5;
+        const long long expected_particle = static_cast<long long>((i - 1) % 6);
+        CHECK(cells[0] == std::to_string(expected_step));
+        CHECK(cells[2] == std::to_string(expected_particle));
+        for (const std::string& cell : cells) CHECK(is_finite_number(cell));
+        CHECK(std::stod(cells[1]) == Approx(expected_step * dt).margin(1e-6));
+    }
+    // The pinned top corners (particles 0 and 1 of a 3 x 2 grid) do not move.
+    CHECK(split(lines[1], ',')[3] == split(lines[25], ',')[3]);
+    CHECK(split(lines[1], ',')[4] == split(lines[25], ',')[4]);
+    CHECK(split(lines[2], ',')[4] == split(lines[26], ',')[4]);
+    // A free particle falls.
+    CHECK(std::stod(split(lines[30], ',')[4]) < std::stod(split(lines[6], ',')[4]));
+}
+
+TEST_CASE("cli: --trajectory records the last step even when it is not a multiple of --every") {
+    const TempDir dir("trajectory_last");
+    const fs::path csv = dir / "out.csv";
+    const RunResult r = run_clothsim({"--headless", "--trajectory", csv.string(), "--every", "4", "--steps", "10",
+                                      "--set", "cloth.rows=2", "--set", "cloth.cols=2"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const std::vector<std::string> lines = lines_of(read_file(csv));
+    REQUIRE(lines.size() == 1 + 4 * 4);  // steps 0, 4, 8, 10
+    std::vector<std::string> steps;
+    for (std::size_t i = 1; i < lines.size(); i += 4) steps.push_back(split(lines[i], ',')[0]);
+    CHECK(steps == std::vector<std::string>{"0", "4", "8", "10"});
+}
+
+TEST_CASE("cli: --obj writes the final mesh") {
+    const TempDir dir("obj");
+    const fs::path obj = dir / "out.obj";
+    const int rows = 4, cols = 3;
+    const RunResult r = run_clothsim({"--headless", "--obj", obj.string(), "--steps", "5", "--set",
+                                      "cloth.rows=" + std::to_string(rows), "--set",
+                                      "cloth.cols=" + std::to_string(cols)});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    REQUIRE(fs::exists(obj));
+    const int n = rows * cols;
+    int v = 0, vt = 0, f = 0;
+    for (const std::string& line : lines_of(read_file(obj))) {
+        INFO(line);
+        if (line.rfind("v ", 0) == 0) {
+            ++v;
+            const std::vector<std::string> parts = split(line, ' ');
+            REQUIRE(parts.size() == 4);
+            for (std::size_t k = 1; k < 4; ++k) CHECK(is_finite_number(parts[k]));
+        } else if (line.rfind("vt ", 0) == 0) {
+            ++vt;
+            const std::vector<std::string> parts = split(line, ' ');
+            REQUIRE(parts.size() == 3);
+            for (std::size_t k = 1; k < 3; ++k) {
+                REQUIRE(is_finite_number(parts[k]));
+                CHECK(std::stod(parts[k]) >= 0.0);
+                CHECK(std::stod(parts[k]) <= 1.0);
+            }
+        } else if (line.rfind("f ", 0) == 0) {
+            ++f;
+            const std::vector<std::string> parts = split(line, ' ');
+            REQUIRE(parts.size() == 4);
+            for (std::size_t k = 1; k < 4; ++k) {
+                const std::vector<std::string> refs = split(parts[k], '/');
+                REQUIRE(refs.size() == 2);
+                for (const std::string& ref : refs) {
+                    const int index = std::stoi(ref);
+                    CHECK(index >= 1);
+                    CHECK(index <= n);
+                }
+            }
+        } else {
+            CHECK((line.empty() || line[0] == '#'));
+        }
+    }
+    CHECK(v == n);
+    CHECK(vt == n);
+    CHECK(f == 2 * (rows - 1) * (cols - 1));
+}
+
+TEST_CASE("cli: the same run twice writes byte-identical trajectories (determinism)") {
+    const TempDir dir("determinism");
+    const fs::path a = dir / "a.csv", b = dir / "b.csv";
+    for (const fs::path& path : {a, b}) {
+        const RunResult r = run_clothsim({"--headless", "--scene", "flag", "--set", "cloth.rows=8", "--set",
+                                          "cloth.cols=10", "--steps", "30", "--every", "3", "--trajectory",
+                                          path.string()});
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+    }
+    const std::string first = read_file(a);
+    const std::string second = read_file(b);
+    CHECK(lines_of(first).size() == 1 + 11 * 80);
+    CHECK(first == second);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Information flags
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("cli: --help exits 0 and lists the flags") {
+    const RunResult r = run_clothsim({"--help"});
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+    for (const char* flag : {"--headless", "--scene", "--duration", "--steps", "--set", "--trajectory", "--every",
+                             "--obj", "--json", "--list-scenes", "--list-fields"}) {
+        CHECK_THAT(r.out, Contains(flag));
+    }
+}
+
+TEST_CASE("cli: --list-scenes prints the bundled scenes") {
+    const RunResult r = run_clothsim({"--list-scenes"});
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+    CHECK(lines_of(r.out) ==
+          std::vector<std::string>{"curtain", "drape-cube", "drape-sphere", "falling", "flag", "hanging"});
+}
+
+TEST_CASE("cli: --list-fields lists every scene field") {
+    const RunResult r = run_clothsim({"--list-fields"});
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+    const std::vector<std::string> lines = lines_of(r.out);
+    REQUIRE(lines.size() == clothsim::scene_fields().size());
+    std::size_t i = 0;
+    for (const clothsim::FieldInfo& f : clothsim::scene_fields()) {
+        INFO("field " << f.name);
+        CHECK(lines[i].rfind(std::string(f.name), 0) == 0);
+        CHECK_THAT(lines[i], Contains(clothsim::describe_allowed(f)));
+        ++i;
+    }
+}
+
+TEST_CASE("cli: --print-scene prints the scene after --set as TOML that loads back") {
+    const RunResult r = run_clothsim({"--print-scene", "--scene", "curtain", "--set", "cloth.rows=7"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    clothsim::Scene expected = clothsim::load_scene("curtain");
+    clothsim::apply_override(expected, "cloth.rows=7");
+    CHECK(r.out == clothsim::to_toml(expected));
+    const clothsim::Scene back = clothsim::parse_scene(r.out, "printed.toml");
+    CHECK(back.cloth.rows == 7);
+    CHECK(clothsim::to_toml(back) == r.out);
+}

@@ -1,6 +1,8 @@
 // The cloth builder: grid placement along the axes, spring counts and rest lengths per kind, mass, triangles.
 #include "support.hpp"
 
+#include "clothsim/normals.hpp"
+
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
@@ -111,4 +113,40 @@ TEST_CASE("cloth_builder rejects what it cannot build with a message", "[cloth_b
     s = Scene{};
     s.pins.particles = {{40, 0}};
     CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("outside the 32 x 32 grid"));
+}
+
+TEST_CASE("cloth_builder vertex normals of a flat cloth are u x v; a folded one averages by area", "[normals]") {
+    Scene s;
+    s.cloth.rows = 4;
+    s.cloth.cols = 5;
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    MassSpring sim = build_simulation(s);
+    std::vector<glm::vec3> normals;
+    compute_vertex_normals(sim.topology(), sim.state().position, normals);
+    REQUIRE(normals.size() == sim.particle_count());
+    for (const glm::vec3& n : normals) CHECK(n.y == Approx(-1.0f));
+
+    // A 2 x 3 strip folded 90 degrees along its middle column. Vertex 1 touches two triangles of the flat
+    // face (normal -y) and one of the folded face (normal -x): by area, (-1, -2) / sqrt(5); vertex 4 the
+    // reverse.
+    Topology t;
+    t.rows = 2;
+    t.cols = 3;
+    t.triangles = {{0, 1, 3}, {1, 4, 3}, {1, 2, 4}, {2, 5, 4}};
+    Vec3Array p;
+    p.resize(6);
+    p.set(0, {-1, 0, 0}), p.set(1, {0, 0, 0}), p.set(2, {0, -1, 0});
+    p.set(3, {-1, 0, 1}), p.set(4, {0, 0, 1}), p.set(5, {0, -1, 1});
+    compute_vertex_normals(t, p, normals);
+    CHECK(normals[0].y == Approx(-1.0f));
+    CHECK(normals[2].x == Approx(-1.0f));
+    CHECK(normals[1].x == Approx(-1.0f / std::sqrt(5.0f)));
+    CHECK(normals[1].y == Approx(-2.0f / std::sqrt(5.0f)));
+    CHECK(normals[4].x == Approx(-2.0f / std::sqrt(5.0f)));
+    CHECK(normals[4].y == Approx(-1.0f / std::sqrt(5.0f)));
+    // A chain has no triangles: a fixed, finite normal.
+    Topology chain;
+    compute_vertex_normals(chain, p, normals);
+    CHECK(normals[3] == glm::vec3(0.0f, 1.0f, 0.0f));
 }

@@ -1,0 +1,17 @@
+// Per-vertex normals of the cloth for rendering: the area-weighted mean of the adjacent triangles' normals
+// (each triangle adds its un-normalised cross product, whose length is twice its area).
+#pragma once
+
+#include "clothsim/state.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <vector>
+
+namespace clothsim {
+
+// Resizes `normals` to the particle count. A particle in no triangle (a 1 x N chain) gets u x v of nothing:
+// (0, 1, 0), so the renderer never normalises a zero vector.
+void compute_vertex_normals(const Topology& topology, const Vec3Array& position, std::vector<glm::vec3>& normals);
+
+}  // namespace clothsim

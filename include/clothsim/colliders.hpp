@@ -1,10 +1,11 @@
 // Collision with a sphere, an axis-aligned box and the ground plane.
 //
 // After integration every free particle closer than `thickness` to a collider surface is projected out
-// to that distance along the surface normal (the box: along the shortest way out). Friction then acts
-// on the step's tangential displacement like Coulomb friction in position-based dynamics (Mueller et al.
-// 2007, Macklin et al. 2014): the tangential motion is reduced by at most mu times the normal
-// correction, and stops when it is smaller (static friction). A particle resting on a plane is pushed
+// to that distance along the surface normal (the box: along the shortest way out). The contact is
+// inelastic: the inward part of the substep's motion is removed, and the push itself adds no velocity.
+// Friction acts on the tangential motion like Coulomb friction in position-based dynamics (Mueller et
+// al. 2007, Macklin et al. 2014): it is reduced by at most mu times the normal correction, and stops
+// when it is smaller (static friction). A particle resting on a plane is pushed
 // back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
 #pragma once
 

@@ -64,7 +64,10 @@ public:
 
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
-    // Moves a particle and gives it a velocity (for grabbing and for tests); others keep theirs.
+    // Moves a pinned particle to `position` (a grab, a moving anchor); it carries no velocity of its own, its
+    // springs pull on its neighbours from the new place at the next step. Does nothing to a free particle.
+    void move_pinned(std::size_t i, glm::vec3 position);
+    // Moves a particle and gives it a velocity (for tests and tools); others keep theirs.
     void set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity);
 
 private:
@@ -80,5 +83,9 @@ private:
     float rest_area_ = 0.0f; // m^2: sum of the triangles' rest areas
     double carry_ = 0.0;     // s: time advance() has not yet stepped
 };
+
+// The box around the cloth's finite particles and the enabled sphere and cube (for cameras and shadows).
+// An empty or all-NaN cloth gives the box at the origin.
+void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi);
 
 }  // namespace clothsim

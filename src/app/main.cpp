@@ -1,11 +1,14 @@
-// clothsim: command-line entry. Parses flags (CLI11), loads the scene and its --set overrides, then runs
-// headless. Exit codes: 0 ok, 2 bad input, 3 the simulation became non-finite.
+// clothsim: command-line entry. Parses flags (CLI11), loads the scene and its --set overrides, then opens
+// the desktop app, or runs headless. Exit codes: 0 ok, 2 bad input (or no display / OpenGL 3.3),
+// 3 the simulation became non-finite.
+#include "app.hpp"
 #include "headless.hpp"
 
 #include "clothsim/scene.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
 
 int main(int argc, char** argv) {
@@ -18,6 +21,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     HeadlessOptions options;
     bool list_scenes = false, list_fields = false, print_scene = false;
+    AppOptions app_options;
+    std::string size_text;
 
     app.add_flag("--headless", headless, "Simulate without a window and report on stdout");
     app.add_option("--scene", scene_name, "Bundled scene name or path to a .toml scene file")->capture_default_str();
@@ -37,6 +42,11 @@ int main(int argc, char** argv) {
     app.add_flag("--list-scenes", list_scenes, "List the bundled scenes and exit");
     app.add_flag("--list-fields", list_fields, "List every scene field with its unit and allowed values, and exit");
     app.add_flag("--print-scene", print_scene, "Print the scene (after --set) as TOML and exit");
+    auto* frames = app.add_option("--frames", app_options.frames, "App: run N frames (one step each), then exit")
+                       ->check(CLI::PositiveNumber);
+    app.add_option("--screenshot", app_options.screenshot, "App: with --frames, write the last frame as PNG")
+        ->needs(frames);
+    app.add_option("--size", size_text, "App: window size WxH in screen coordinates (default 1280x720)");
 
     try {
         app.parse(argc, argv);
@@ -66,11 +76,20 @@ int main(int argc, char** argv) {
             std::cout << to_toml(scene);
             return kExitOk;
         }
-        if (!headless) {
-            std::cerr << "clothsim: error: the desktop app is not built yet; run with --headless\n";
-            return kExitBadInput;
+        if (headless) return run_headless(scene, options);
+        if (!size_text.empty()) {
+            int w = 0, h = 0;
+            char tail = 0;
+            if (std::sscanf(size_text.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 8192 ||
+                h > 8192) {
+                std::cerr << "clothsim: error: --size " << size_text
+                          << ": expected WIDTHxHEIGHT, each in [64, 8192], e.g. 1280x720\n";
+                return kExitBadInput;
+            }
+            app_options.size = {w, h};
         }
-        return run_headless(scene, options);
+        app_options.scene_source = scene_name;
+        return run_app(scene, app_options);
     } catch (const SceneError& e) {
         std::cerr << "clothsim: error: " << e.what() << "\n";
         return kExitBadInput;

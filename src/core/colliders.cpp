@@ -57,16 +57,18 @@ void collide_shape(State& state, const Shape& shape, float friction, float thick
         if (state.pinned[i]) continue;
         const Contact c = contact(shape, state.position.get(i), thickness);
         if (!(c.depth > 0.0f)) continue;
-        glm::vec3 correction = c.normal * c.depth;
-        if (friction > 0.0f) {
-            const glm::vec3 step = state.motion.get(i) + correction;  // x' - x_prev after the push
-            const glm::vec3 tangential = step - glm::dot(step, c.normal) * c.normal;
-            const float slide = glm::length(tangential);
-            if (slide > 0.0f) correction -= tangential * (std::min(slide, friction * c.depth) / slide);
-        }
-        // Moving x moves the substep's motion with it: x_prev stays where it was.
-        state.position.add(i, correction);
-        state.motion.add(i, correction);
+        const glm::vec3 motion = state.motion.get(i);
+        const float normal_motion = glm::dot(motion, c.normal);
+        const glm::vec3 tangential = motion - normal_motion * c.normal;
+        // Coulomb: the tangential motion loses at most mu times the normal push (static when it is less).
+        const float slide = glm::length(tangential);
+        const glm::vec3 friction_cut =
+            slide > 0.0f ? -tangential * (std::min(slide, friction * c.depth) / slide) : glm::vec3(0.0f);
+        state.position.add(i, c.normal * c.depth + friction_cut);
+        // Inelastic contact: the push moves the particle out but does not launch it. Keeping the push in
+        // the motion (x_prev left in place, as plain Verlet projection does) turns a deep penetration into a
+        // velocity of depth / h: a cloth started half inside the sphere exploded that way.
+        state.motion.set(i, tangential + friction_cut + std::max(normal_motion, 0.0f) * c.normal);
     }
 }
 

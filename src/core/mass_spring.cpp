@@ -4,6 +4,7 @@
 #include "forces.hpp"
 #include "verlet.hpp"
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include <cmath>
@@ -134,11 +135,38 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     if (pinned) state_.motion.set(i, glm::vec3(0.0f));
 }
 
+void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
+    if (!state_.pinned.at(i)) return;
+    state_.position.set(i, position);
+    state_.motion.set(i, glm::vec3(0.0f));
+}
+
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {
     std::vector<glm::vec3> v = velocities();
     state_.position.set(i, position);
     v.at(i) = state_.pinned[i] ? glm::vec3(0.0f) : velocity;
     restart(v, substep_length());
+}
+
+void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi) {
+    lo = glm::vec3(INFINITY);
+    hi = glm::vec3(-INFINITY);
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::vec3 p = sim.position(i);
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const ColliderSettings& c = sim.settings().colliders;
+    if (c.sphere.enabled) {
+        lo = glm::min(lo, c.sphere.center - glm::vec3(c.sphere.radius));
+        hi = glm::max(hi, c.sphere.center + glm::vec3(c.sphere.radius));
+    }
+    if (c.cube.enabled) {
+        lo = glm::min(lo, c.cube.center - 0.5f * c.cube.size);
+        hi = glm::max(hi, c.cube.center + 0.5f * c.cube.size);
+    }
+    if (!(lo.x <= hi.x)) lo = hi = glm::vec3(0.0f);
 }
 
 }  // namespace clothsim

@@ -67,12 +67,14 @@ private:
 };
 
 // Runs the clothsim executable with `args`; stdout is captured through the pipe, stderr through a file.
-RunResult run_clothsim(const std::vector<std::string>& args) {
+// `prefix` goes before the command (e.g. "env -u DISPLAY" to run without a display).
+RunResult run_clothsim(const std::vector<std::string>& args, const std::string& prefix = "") {
     static int counter = 0;
     const fs::path err_file =
         fs::temp_directory_path() /
         ("clothsim_test_" + std::to_string(::getpid()) + "_stderr_" + std::to_string(counter++) + ".txt");
-    std::string command = quote(CLOTHSIM_EXE);
+    std::string command = prefix;
+    command.append(prefix.empty() ? "" : " ").append(quote(CLOTHSIM_EXE));
     // Appends, not "literal" + string: GCC 12 warns falsely on that (-Wrestrict, GCC bug 105329).
     for (const std::string& a : args) command.append(" ").append(quote(a));
     command.append(" 2>").append(quote(err_file.string()));
@@ -123,11 +125,12 @@ bool is_finite_number(const std::string& text) {
 #define CAPTURE_RUN(r) INFO("exit code " << (r).code << "\nstdout:\n" << (r).out << "\nstderr:\n" << (r).err)
 
 // Runs expecting exit code 2 (bad input) and a message on stderr with every one of `needles`.
-void expect_bad_input(const std::vector<std::string>& args, std::initializer_list<std::string> needles) {
+void expect_bad_input(const std::vector<std::string>& args, std::initializer_list<std::string> needles,
+                      const std::string& prefix = "") {
     std::string joined;
     for (const std::string& a : args) joined += " " + a;
     INFO("clothsim" << joined);
-    const RunResult r = run_clothsim(args);
+    const RunResult r = run_clothsim(args, prefix);
     CAPTURE_RUN(r);
     CHECK(r.code == 2);
     CHECK_THAT(r.err, Contains("clothsim: error:"));
@@ -269,9 +272,17 @@ TEST_CASE("cli: --obj naming a directory exits 2 before simulating") {
     expect_bad_input({"--headless", "--steps", "1", "--obj", path}, {"--obj", path, "is a directory"});
 }
 
-TEST_CASE("cli: running without --headless exits 2 and mentions --headless") {
-    expect_bad_input({}, {"--headless"});
-    expect_bad_input({"--scene", "flag", "--steps", "1"}, {"--headless"});
+TEST_CASE("cli: the app without a display exits 2, names the problem and mentions --headless") {
+    expect_bad_input({}, {"DISPLAY", "--headless"}, "env -u DISPLAY -u WAYLAND_DISPLAY");
+    expect_bad_input({"--scene", "flag", "--frames", "1"}, {"cannot open a window", "--headless"},
+                     "env -u DISPLAY -u WAYLAND_DISPLAY");
+}
+
+TEST_CASE("cli: app flags are checked before a window opens") {
+    expect_bad_input({"--size", "12x"}, {"--size", "WIDTHxHEIGHT"});
+    expect_bad_input({"--size", "10x10"}, {"[64, 8192]"});
+    expect_bad_input({"--screenshot", "x.png"}, {"--frames"});
+    expect_bad_input({"--frames", "0"}, {"--frames"});
 }
 
 // ---------------------------------------------------------------------------------------------------------

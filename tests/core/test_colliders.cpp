@@ -84,8 +84,18 @@ TEST_CASE("colliders push particles out along the shortest way", "[colliders]") 
     CHECK(st.position.get(1).y == 0.5f);
     CHECK(st.position.get(2).z == Approx(-0.51f));
     CHECK(st.position.get(3) == glm::vec3(0.0f, 0.5f, 0.0f));
-    // The motion moves with the push, so the particle does not bounce back out.
-    CHECK(st.motion.get(0).y == Approx(0.11f));
+    // The push moves the particle but gives it no velocity: a deep penetration must not launch it.
+    CHECK(st.motion.get(0) == glm::vec3(0.0f));
+    // Inward motion is removed (inelastic), outward and tangential motion kept when frictionless.
+    st.position.set(0, {0.1f, 0.95f, 0.0f});
+    st.motion.set(0, {0.02f, -0.01f, 0.0f});
+    collide(st, cube, 0.01f);
+    CHECK(st.motion.get(0).x == Approx(0.02f));
+    CHECK(st.motion.get(0).y == 0.0f);
+    st.position.set(0, {0.1f, 0.95f, 0.0f});
+    st.motion.set(0, {0.0f, 0.03f, 0.0f});  // already leaving: keeps its outward motion
+    collide(st, cube, 0.01f);
+    CHECK(st.motion.get(0).y == Approx(0.03f));
 
     st.position.set(0, {0.3f, 0.4f, 0.0f});  // inside the sphere of radius 1 at the origin
     collide(st, SphereCollider{true, {0.0f, 0.0f, 0.0f}, 1.0f, 0.0f}, 0.0f);

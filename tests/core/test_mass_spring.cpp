@@ -81,9 +81,19 @@ TEST_CASE("mass_spring pinned particles never move", "[mass_spring]") {
     const glm::vec3 held = sim.position(500);
     sim.run_steps(30);
     CHECK(sim.position(500) == held);
+    // A moved pin (a grab) stays exactly where it is put and drags its neighbours along.
+    const glm::vec3 neighbour = sim.position(501);
+    sim.move_pinned(500, held + glm::vec3(0.0f, 0.0f, 0.3f));
+    sim.run_steps(30);
+    CHECK(sim.position(500) == held + glm::vec3(0.0f, 0.0f, 0.3f));
+    CHECK(sim.position(501).z > neighbour.z + 0.1f);
     sim.set_pinned(500, false);
     sim.run_steps(30);
-    CHECK(sim.position(500) != held);
+    CHECK(sim.position(500) != held + glm::vec3(0.0f, 0.0f, 0.3f));
+    // move_pinned leaves free particles alone.
+    const glm::vec3 free_particle = sim.position(10);
+    sim.move_pinned(10, glm::vec3(5.0f));
+    CHECK(sim.position(10) == free_particle);
 }
 
 TEST_CASE("mass_spring the same scene run twice gives bit-identical positions", "[mass_spring]") {

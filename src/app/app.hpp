@@ -1,0 +1,31 @@
+// The desktop app: a window, the renderer and the settings panel around one MassSpring.
+#pragma once
+
+#include "clothsim/settings.hpp"
+
+#include <glm/vec2.hpp>
+
+#include <optional>
+#include <string>
+
+namespace clothsim {
+
+struct AppOptions {
+    std::string scene_source = "hanging";  // bundled name or path, shown in the panel
+    glm::ivec2 size{1280, 720};            // window size in screen coordinates
+    // Scripted rendering: run exactly `frames` frames (one step of integration.dt each, whatever the wall
+    // clock says), write the last one to `screenshot` (panel included) and exit.
+    std::optional<long long> frames;
+    std::string screenshot;
+};
+
+// Returns the process exit code: 0, or 2 when no window / OpenGL 3.3 / shader / texture / screenshot file.
+int run_app(const Scene& scene, const AppOptions& options);
+
+// Writes the current back buffer (RGBA, bottom-up) as PNG; returns an error message or "".
+std::string write_screenshot(const std::string& path, int width, int height);
+
+// "clothsim-20261124-101530.png": screenshots taken with F12.
+std::string timestamped_screenshot_name();
+
+}  // namespace clothsim

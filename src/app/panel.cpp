@@ -1,0 +1,330 @@
+// The settings panel (Dear ImGui). Scene fields are drawn from the field table (scene_fields.cpp), so each
+// widget's tooltip gives the field's unit, meaning and allowed range, and each field can be reset to the
+// loaded scene's value or the built-in default (right-click, or the small button that appears once changed).
+#include "app_state.hpp"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <variant>
+
+namespace clothsim {
+namespace {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+    using Ts::operator()...;
+};
+
+// Slider extents for fields whose valid range is too wide to drag through (the valid range still applies:
+// ctrl+click types any allowed value).
+struct SliderHint {
+    const char* field;
+    float lo, hi;
+    bool logarithmic;
+};
+constexpr SliderHint kHints[] = {
+    {"springs.structural", 1.0f, 1e6f, true}, {"springs.shear", 0.0f, 1e6f, true},
+    {"springs.bending", 0.0f, 1e5f, true},    {"springs.damping", 0.0f, 100.0f, true},
+    {"forces.drag", 0.0f, 10.0f, true},       {"cloth.mass", 0.001f, 100.0f, true},
+    {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
+};
+
+const SliderHint* hint_for(std::string_view name) {
+    for (const SliderHint& h : kHints) {
+        if (name == h.field) return &h;
+    }
+    return nullptr;
+}
+
+void tooltip(const FieldInfo& f) {
+    if (!ImGui::IsItemHovered()) return;
+    ImGui::BeginTooltip();
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);
+    ImGui::TextUnformatted(std::string(f.name).c_str());
+    ImGui::TextUnformatted(std::string(f.help).c_str());
+    if (!f.unit.empty()) ImGui::Text("unit: %s", std::string(f.unit).c_str());
+    ImGui::TextDisabled("allowed: %s", describe_allowed(f).c_str());
+    ImGui::TextDisabled("ctrl+click to type a value; right-click to reset");
+    ImGui::PopTextWrapPos();
+    ImGui::EndTooltip();
+}
+
+// Copies one field's value from `from` into `to`.
+void copy_field(const FieldInfo& f, const Scene& from, Scene& to) {
+    Scene& source = const_cast<Scene&>(from);  // read only: the table hands out mutable references
+    std::visit([&](auto* dst) { std::visit([&](auto* src) {
+                   if constexpr (std::is_same_v<decltype(dst), decltype(src)>) *dst = *src;
+               }, f.ref(source)); },
+               f.ref(to));
+}
+
+// The label shown for a field: its last name component ("structural" for springs.structural).
+std::string label_of(const FieldInfo& f) {
+    const auto dot = f.name.rfind('.');
+    return std::string(dot == std::string_view::npos ? f.name : f.name.substr(dot + 1));
+}
+
+// Draws one field's widget; returns true when the user changed it.
+bool field_widget(AppState& app, const FieldInfo& f) {
+    ImGui::PushID(f.name.data(), f.name.data() + f.name.size());
+    const std::string label = label_of(f);
+    bool changed = std::visit(
+        Overloaded{
+            [&](int* v) {
+                return ImGui::DragInt(label.c_str(), v, 0.2f, static_cast<int>(f.min), static_cast<int>(f.max), "%d",
+                                      ImGuiSliderFlags_AlwaysClamp);
+            },
+            [&](float* v) {
+                if (const SliderHint* h = hint_for(f.name)) {
+                    const bool edited = ImGui::SliderFloat(label.c_str(), v, h->lo, h->hi, "%.4g",
+                                                           h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
+                    *v = std::clamp(*v, static_cast<float>(f.min), static_cast<float>(f.max));
+                    return edited;
+                }
+                const float speed = std::max(std::fabs(*v) * 0.01f, 0.001f);
+                return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max),
+                                        "%.4g", ImGuiSliderFlags_AlwaysClamp);
+            },
+            [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
+            [&](glm::vec2* v) {
+                return ImGui::DragFloat2(label.c_str(), &v->x, 0.01f, static_cast<float>(f.min),
+                                         static_cast<float>(f.max), "%.3g", ImGuiSliderFlags_AlwaysClamp);
+            },
+            [&](glm::vec3* v) {
+                const float speed = std::max(0.005f, 0.01f * std::max({std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)}));
+                return ImGui::DragFloat3(label.c_str(), &v->x, speed, static_cast<float>(f.min),
+                                         static_cast<float>(f.max), "%.3g", ImGuiSliderFlags_AlwaysClamp);
+            },
+            [&](std::string* v) {
+                char buffer[256];
+                std::snprintf(buffer, sizeof buffer, "%s", v->c_str());
+                if (ImGui::InputText(label.c_str(), buffer, sizeof buffer)) {
+                    *v = buffer;
+                    return true;
+                }
+                return false;
+            },
+            [&](PinSpec* v) {
+                int preset = static_cast<int>(v->preset);
+                const auto names = pin_preset_names();
+                const std::string preview =
+                    std::string(names[preset]) + (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
+                bool edited = false;
+                if (ImGui::BeginCombo(label.c_str(), preview.c_str())) {
+                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == preset && v->particles.empty())) {
+                            v->preset = static_cast<PinPreset>(i);
+                            v->particles.clear();
+                            edited = true;
+                        }
+                    }
+                    ImGui::EndCombo();
+                }
+                return edited;
+            },
+            [&](WindModel* v) {
+                int model = static_cast<int>(*v);
+                const auto names = wind_model_names();
+                bool edited = false;
+                if (ImGui::BeginCombo(label.c_str(), std::string(names[model]).c_str())) {
+                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == model)) {
+                            *v = static_cast<WindModel>(i);
+                            edited = true;
+                        }
+                    }
+                    ImGui::EndCombo();
+                }
+                return edited;
+            },
+        },
+        f.ref(app.scene));
+    tooltip(f);
+
+    // Reset: a small button once the value differs from the loaded scene's, and a right-click menu.
+    const std::string current = format_value(app.scene, f);
+    const std::string scene_value = format_value(app.loaded, f);
+    const std::string builtin = format_value(Scene{}, f);
+    if (ImGui::BeginPopupContextItem("reset")) {
+        if (ImGui::MenuItem(("Reset to scene value " + scene_value).c_str())) {
+            copy_field(f, app.loaded, app.scene);
+            changed = true;
+        }
+        if (ImGui::MenuItem(("Reset to built-in default " + builtin).c_str())) {
+            copy_field(f, Scene{}, app.scene);
+            changed = true;
+        }
+        ImGui::EndPopup();
+    }
+    if (current != scene_value) {
+        ImGui::SameLine();
+        if (ImGui::SmallButton("reset")) {
+            copy_field(f, app.loaded, app.scene);
+            changed = true;
+        }
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the scene's value %s", scene_value.c_str());
+    }
+    ImGui::PopID();
+    return changed;
+}
+
+// Draws every field whose name starts with `prefix`; returns true when any changed.
+bool fields_section(AppState& app, std::string_view prefix) {
+    bool changed = false;
+    for (const FieldInfo& f : scene_fields()) {
+        if (f.name.starts_with(prefix)) changed |= field_widget(app, f);
+    }
+    return changed;
+}
+
+void plot(const char* label, const History& h, ImVec4 color) {
+    char overlay[64];
+    std::snprintf(overlay, sizeof overlay, "%s %.4g J", label, h.last());
+    ImGui::PushStyleColor(ImGuiCol_PlotLines, color);
+    ImGui::PlotLines("##energy", h.values.data(), h.size(), h.offset(), overlay, FLT_MAX, FLT_MAX,
+                     ImVec2(ImGui::GetContentRegionAvail().x, 3.5f * ImGui::GetFontSize()));
+    ImGui::PopStyleColor();
+}
+
+void help_section() {
+    ImGui::TextUnformatted("Mouse");
+    ImGui::BulletText("left-drag on empty space: orbit");
+    ImGui::BulletText("right- or middle-drag, shift+left-drag: pan");
+    ImGui::BulletText("wheel: zoom");
+    ImGui::BulletText("left-drag on the cloth: grab a particle");
+    ImGui::BulletText("ctrl+click on the cloth: pin / unpin a particle");
+    ImGui::TextUnformatted("Keys");
+    ImGui::BulletText("Space: pause / play      S: single step");
+    ImGui::BulletText("R: reset the scene       W: wireframe");
+    ImGui::BulletText("H: hide / show panel     F: frame the cloth");
+    ImGui::BulletText("Home: reset the camera   F12: screenshot");
+    ImGui::BulletText("Esc: quit");
+}
+
+}  // namespace
+
+float panel_width(const AppState& app, float content_scale) { return app.show_panel ? 360.0f * content_scale : 0.0f; }
+
+PanelRequests draw_panel(AppState& app, float content_scale) {
+    PanelRequests requests;
+    const ImGuiViewport* viewport = ImGui::GetMainViewport();
+    ImGui::SetNextWindowPos(viewport->WorkPos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(panel_width(app, content_scale), viewport->WorkSize.y), ImGuiCond_Always);
+    ImGui::SetNextWindowBgAlpha(0.92f);
+    ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    ImGui::PushItemWidth(-ImGui::GetFontSize() * 8.5f);
+
+    if (!app.status.empty()) {
+        ImGui::PushTextWrapPos(0.0f);
+        ImGui::TextColored(app.status_is_error ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
+                           app.status.c_str());
+        ImGui::PopTextWrapPos();
+        ImGui::Separator();
+    }
+
+    if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const std::vector<std::string> names = bundled_scene_names();
+        if (ImGui::BeginCombo("bundled", app.scene_source.c_str())) {
+            for (const std::string& n : names) {
+                if (ImGui::Selectable(n.c_str(), n == app.scene_source)) requests.load = n;
+            }
+            ImGui::EndCombo();
+        }
+        char open[512];
+        std::snprintf(open, sizeof open, "%s", app.open_path.c_str());
+        if (ImGui::InputText("##open", open, sizeof open)) app.open_path = open;
+        ImGui::SameLine();
+        if (ImGui::Button("Open file")) requests.load = app.open_path;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("load a .toml scene file; a bad file is rejected and nothing changes");
+        if (ImGui::Button(app.paused ? "Play (Space)" : "Pause (Space)")) app.paused = !app.paused;
+        ImGui::SameLine();
+        if (ImGui::Button("Step (S)")) {
+            app.paused = true;
+            app.step_once = true;
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("Reset (R)")) requests.reset = true;
+        ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
+        char save[512];
+        std::snprintf(save, sizeof save, "%s", app.save_path.c_str());
+        if (ImGui::InputText("##save", save, sizeof save)) app.save_path = save;
+        ImGui::SameLine();
+        if (ImGui::Button("Save scene as")) requests.save = app.save_path;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the current settings as a scene file (atomically)");
+    }
+    if (ImGui::CollapsingHeader("Cloth")) {
+        ImGui::TextDisabled("changes rebuild the cloth");
+        requests.rebuild |= fields_section(app, "cloth.");
+        requests.rebuild |= fields_section(app, "pins");
+    }
+    if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(app, "springs.");
+    if (ImGui::CollapsingHeader("Forces")) fields_section(app, "forces.");
+    if (ImGui::CollapsingHeader("Integration")) {
+        fields_section(app, "integration.");
+        ImGui::Text("substep %.4g ms", 1000.0 * app.scene.settings.integration.dt / app.scene.settings.integration.substeps);
+        ImGui::SliderInt("max catch-up steps", &app.max_catchup_steps, 1, 16);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
+    }
+    if (ImGui::CollapsingHeader("Colliders")) {
+        ImGui::TextDisabled("sphere");
+        fields_section(app, "colliders.sphere.");
+        ImGui::Separator();
+        ImGui::TextDisabled("cube");
+        fields_section(app, "colliders.cube.");
+        ImGui::Separator();
+        ImGui::TextDisabled("ground");
+        fields_section(app, "colliders.ground.");
+        fields_section(app, "colliders.thickness");
+    }
+    if (ImGui::CollapsingHeader("View")) {
+        ImGui::Checkbox("wireframe (W)", &app.view.wireframe);
+        int springs = static_cast<int>(app.view.springs);
+        ImGui::Combo("springs", &springs, "hidden\0by kind\0by strain\0");
+        app.view.springs = static_cast<SpringView>(springs);
+        if (app.view.springs == SpringView::ByKind) {
+            ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.2f, 1.0f), "structural");
+            ImGui::SameLine();
+            ImGui::TextColored(ImVec4(0.2f, 0.85f, 1.0f, 1.0f), "shear");
+            ImGui::SameLine();
+            ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.9f, 1.0f), "bending");
+        }
+        if (app.view.springs == SpringView::ByStrain) {
+            ImGui::SliderFloat("strain range", &app.view.strain_range, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
+            ImGui::TextDisabled("blue compressed, white at rest, red stretched");
+        }
+        ImGui::Checkbox("particles", &app.view.particles);
+        ImGui::Checkbox("highlight pinned particles", &app.view.highlight_pins);
+        ImGui::Checkbox("fabric texture", &app.view.texture);
+        ImGui::Checkbox("shadows", &app.view.shadows);
+        ImGui::Checkbox("vsync", &app.vsync);
+        if (ImGui::Button("Frame cloth (F)")) requests.frame_camera = true;
+        ImGui::SameLine();
+        if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;
+    }
+    if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const ImGuiIO& io = ImGui::GetIO();
+        ImGui::Text("%.0f FPS (%.2f ms per frame)", io.Framerate, 1000.0f / std::max(io.Framerate, 1e-3f));
+        ImGui::Text("simulation %.2f ms (%lld substeps), render %.2f ms", app.stats.sim_ms, app.stats.substeps_last_frame,
+                    app.stats.render_ms);
+        ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
+                    app.sim.time());
+        if (app.stats.dropped_seconds > 0.0) {
+            ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
+                               app.stats.dropped_seconds);
+        }
+        plot("kinetic", app.stats.kinetic, ImVec4(1.0f, 0.6f, 0.3f, 1.0f));
+        plot("potential", app.stats.potential, ImVec4(0.4f, 0.7f, 1.0f, 1.0f));
+        plot("total", app.stats.total, ImVec4(0.9f, 0.9f, 0.9f, 1.0f));
+    }
+    if (ImGui::CollapsingHeader("Help")) help_section();
+    ImGui::PopItemWidth();
+    ImGui::End();
+    return requests;
+}
+
+}  // namespace clothsim

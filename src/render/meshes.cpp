@@ -1,0 +1,65 @@
+#include "meshes.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace clothsim {
+
+MeshData make_uv_sphere(int stacks, int slices) {
+    MeshData m;
+    const float pi = std::numbers::pi_v<float>;
+    for (int i = 0; i <= stacks; ++i) {
+        const float theta = pi * static_cast<float>(i) / static_cast<float>(stacks);  // from +y down
+        for (int j = 0; j <= slices; ++j) {
+            const float phi = 2.0f * pi * static_cast<float>(j) / static_cast<float>(slices);
+            const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+            m.positions.push_back(n);
+            m.normals.push_back(n);
+            m.uvs.emplace_back(static_cast<float>(j) / static_cast<float>(slices),
+                               1.0f - static_cast<float>(i) / static_cast<float>(stacks));
+        }
+    }
+    const auto row = static_cast<std::uint32_t>(slices + 1);
+    for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(stacks); ++i) {
+        for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(slices); ++j) {
+            const std::uint32_t a = i * row + j, b = a + row;
+            m.indices.insert(m.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+        }
+    }
+    return m;
+}
+
+MeshData make_cube() {
+    MeshData m;
+    // Each face: normal n and two in-face axes u, v with u x v = n.
+    const glm::vec3 faces[6][3] = {
+        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+        {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+        {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+    };
+    for (const auto& f : faces) {
+        const auto base = static_cast<std::uint32_t>(m.positions.size());
+        const glm::vec2 corners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        for (const glm::vec2& c : corners) {
+            m.positions.push_back(0.5f * f[0] + (c.x - 0.5f) * f[1] + (c.y - 0.5f) * f[2]);
+            m.normals.push_back(f[0]);
+            m.uvs.push_back(c);
+        }
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    return m;
+}
+
+MeshData make_ground(float half_size) {
+    MeshData m;
+    const glm::vec2 corners[4] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
+    for (const glm::vec2& c : corners) {
+        m.positions.emplace_back(c.x * half_size, 0.0f, c.y * half_size);
+        m.normals.emplace_back(0.0f, 1.0f, 0.0f);
+        m.uvs.emplace_back(c * half_size);
+    }
+    m.indices = {0, 1, 2, 0, 2, 3};
+    return m;
+}
+
+}  // namespace clothsim

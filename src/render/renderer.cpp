@@ -1,0 +1,328 @@
+#include "renderer.hpp"
+
+#include "clothsim/normals.hpp"
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace clothsim {
+namespace {
+
+const glm::vec3 kLightDirection = glm::normalize(glm::vec3(0.45f, 1.0f, 0.35f));  // toward the light
+
+gl::Texture load_texture(const std::filesystem::path& path) {
+    int w = 0, h = 0, channels = 0;
+    stbi_set_flip_vertically_on_load(1);
+    unsigned char* pixels = stbi_load(path.string().c_str(), &w, &h, &channels, 4);
+    if (!pixels) {
+        throw std::runtime_error("cannot load texture '" + path.string() + "': " + stbi_failure_reason());
+    }
+    gl::Texture texture;
+    glBindTexture(GL_TEXTURE_2D, texture.get());
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+    stbi_image_free(pixels);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    return texture;
+}
+
+template <class T>
+void upload(const gl::Buffer& buffer, GLenum target, const std::vector<T>& data, GLenum usage) {
+    glBindBuffer(target, buffer.get());
+    glBufferData(target, static_cast<GLsizeiptr>(data.size() * sizeof(T)), data.data(), usage);
+}
+
+void attribute(GLuint index, const gl::Buffer& buffer, int components) {
+    glBindBuffer(GL_ARRAY_BUFFER, buffer.get());
+    glEnableVertexAttribArray(index);
+    glVertexAttribPointer(index, components, GL_FLOAT, GL_FALSE, 0, nullptr);
+}
+
+// Blue (compressed) through white (rest length) to red (stretched).
+glm::vec4 strain_color(float strain, float range) {
+    const float s = std::clamp(strain / std::max(range, 1e-6f), -1.0f, 1.0f);
+    return s >= 0.0f ? glm::vec4(1.0f, 1.0f - s, 1.0f - s, 1.0f) : glm::vec4(1.0f + s, 1.0f + s, 1.0f, 1.0f);
+}
+
+glm::vec4 kind_color(SpringKind kind) {
+    switch (kind) {
+        case SpringKind::Structural: return {1.0f, 0.85f, 0.2f, 1.0f};
+        case SpringKind::Shear: return {0.2f, 0.85f, 1.0f, 1.0f};
+        case SpringKind::Bending: return {1.0f, 0.35f, 0.9f, 1.0f};
+    }
+    return glm::vec4(1.0f);
+}
+
+}  // namespace
+
+GpuMesh::GpuMesh(const MeshData& data, bool dynamic) : index_count_(static_cast<GLsizei>(data.indices.size())) {
+    glBindVertexArray(vao_.get());
+    const GLenum usage = dynamic ? GL_DYNAMIC_DRAW : GL_STATIC_DRAW;
+    upload(positions_, GL_ARRAY_BUFFER, data.positions, usage);
+    attribute(0, positions_, 3);
+    upload(normals_, GL_ARRAY_BUFFER, data.normals, usage);
+    attribute(1, normals_, 3);
+    upload(uvs_, GL_ARRAY_BUFFER, data.uvs, GL_STATIC_DRAW);
+    attribute(2, uvs_, 2);
+    upload(indices_, GL_ELEMENT_ARRAY_BUFFER, data.indices, GL_STATIC_DRAW);
+    glBindVertexArray(0);
+}
+
+void GpuMesh::update_positions_normals(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals) {
+    glBindBuffer(GL_ARRAY_BUFFER, positions_.get());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(positions.size() * sizeof(glm::vec3)), positions.data());
+    glBindBuffer(GL_ARRAY_BUFFER, normals_.get());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(normals.size() * sizeof(glm::vec3)), normals.data());
+}
+
+void GpuMesh::draw() const {
+    glBindVertexArray(vao_.get());
+    glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+}
+
+Renderer::Renderer(const std::filesystem::path& shader_dir, const std::filesystem::path& texture_dir)
+    : lit_(shader_dir / "lit.vert", shader_dir / "lit.frag"),
+      shadow_(shader_dir / "shadow.vert", shader_dir / "shadow.frag"),
+      lines_(shader_dir / "lines.vert", shader_dir / "lines.frag"),
+      fabric_(load_texture(texture_dir / "fabric.png")),
+      crate_(load_texture(texture_dir / "crate.png")),
+      sphere_(make_uv_sphere(32, 64)),
+      cube_(make_cube()),
+      ground_(make_ground(50.0f)) {
+    glBindTexture(GL_TEXTURE_2D, shadow_depth_.get());
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, shadow_size_, shadow_size_, 0, GL_DEPTH_COMPONENT, GL_FLOAT,
+                 nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_depth_.get(), 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        throw std::runtime_error("the shadow-map framebuffer is incomplete on this OpenGL driver");
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    glBindVertexArray(debug_vao_.get());
+    glBindBuffer(GL_ARRAY_BUFFER, debug_vbo_.get());
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(DebugVertex), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(DebugVertex),
+                          reinterpret_cast<const void*>(offsetof(DebugVertex, color)));
+    glBindVertexArray(0);
+}
+
+void Renderer::set_cloth(const MassSpring& sim) {
+    const Topology& t = sim.topology();
+    MeshData data;
+    data.positions = sim.positions();
+    compute_vertex_normals(t, sim.state().position, data.normals);
+    for (int r = 0; r < t.rows; ++r) {
+        for (int c = 0; c < t.cols; ++c) {
+            data.uvs.emplace_back(t.cols > 1 ? float(c) / float(t.cols - 1) : 0.0f,
+                                  t.rows > 1 ? 1.0f - float(r) / float(t.rows - 1) : 0.0f);
+        }
+    }
+    for (const auto& tri : t.triangles) data.indices.insert(data.indices.end(), tri.begin(), tri.end());
+    cloth_.emplace(data, true);
+    cloth_particles_ = sim.particle_count();
+    // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
+    const float width = glm::length(data.positions[t.index(0, t.cols - 1)] - data.positions[0]);
+    const float height = glm::length(data.positions[t.index(t.rows - 1, 0)] - data.positions[0]);
+    cloth_uv_scale_ = glm::max(glm::vec2(width, height) / 0.12f, glm::vec2(1.0f));
+}
+
+void Renderer::upload_cloth(const MassSpring& sim) {
+    if (!cloth_ || cloth_particles_ != sim.particle_count()) set_cloth(sim);
+    positions_ = sim.positions();
+    compute_vertex_normals(sim.topology(), sim.state().position, normals_);
+    cloth_->update_positions_normals(positions_, normals_);
+}
+
+void Renderer::draw(const RenderInput& input) {
+    upload_cloth(input.sim);
+    const glm::ivec4 vp = input.viewport_px;
+    const float aspect = float(vp.z) / float(std::max(vp.w, 1));
+    const glm::mat4 view_projection = input.camera.projection(aspect) * input.camera.view();
+
+    glm::vec3 lo, hi;
+    scene_bounds(input.sim, lo, hi);
+    lo.y = std::min(lo.y, input.sim.settings().colliders.ground.height);
+    const glm::vec3 center = 0.5f * (lo + hi);
+    const float radius = std::max(0.5f * glm::length(hi - lo), 0.5f) * 1.2f;
+    const glm::mat4 light_view =
+        glm::lookAt(center + kLightDirection * (2.0f * radius), center, glm::vec3(0.0f, 1.0f, 0.0f));
+    const glm::mat4 light_view_projection =
+        glm::ortho(-radius, radius, -radius, radius, 0.01f, 4.0f * radius) * light_view;
+
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    if (input.view.shadows) draw_shadow_map(input, light_view_projection);
+
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, input.framebuffer_px.x, input.framebuffer_px.y);
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    glClearColor(0.42f, 0.47f, 0.54f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glViewport(vp.x, vp.y, vp.z, vp.w);
+    draw_lit(input, view_projection, light_view_projection);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    draw_debug(input, view_projection);
+    glBindVertexArray(0);
+}
+
+void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection) {
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_.get());
+    glViewport(0, 0, shadow_size_, shadow_size_);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    shadow_.use();
+    shadow_.set("u_light_view_projection", light_view_projection);
+    shadow_.set("u_model", glm::mat4(1.0f));
+    if (input.sim.topology().triangles.size() > 0) cloth_->draw();
+    const ColliderSettings& c = input.sim.settings().colliders;
+    if (c.sphere.enabled) {
+        shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.sphere.center), glm::vec3(c.sphere.radius)));
+        sphere_.draw();
+    }
+    if (c.cube.enabled) {
+        shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
+        cube_.draw();
+    }
+}
+
+void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projection,
+                        const glm::mat4& light_view_projection) {
+    lit_.use();
+    lit_.set("u_view_projection", view_projection);
+    lit_.set("u_light_view_projection", light_view_projection);
+    lit_.set("u_light_direction", kLightDirection);
+    lit_.set("u_camera", input.camera.eye());
+    lit_.set("u_use_shadow", input.view.shadows ? 1 : 0);
+    lit_.set("u_texture", 0);
+    lit_.set("u_shadow_map", 1);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, shadow_depth_.get());
+    glActiveTexture(GL_TEXTURE0);
+
+    const ColliderSettings& c = input.sim.settings().colliders;
+    auto material = [&](glm::vec4 color, const gl::Texture* texture, glm::vec2 uv_scale, float specular, float shininess) {
+        lit_.set("u_color", color);
+        lit_.set("u_use_texture", texture ? 1 : 0);
+        if (texture) glBindTexture(GL_TEXTURE_2D, texture->get());
+        glUniform2f(lit_.location("u_uv_scale"), uv_scale.x, uv_scale.y);
+        lit_.set("u_specular", specular);
+        lit_.set("u_shininess", shininess);
+        lit_.set("u_grid", 0);
+    };
+
+    // Ground: opaque when it collides, a faint grid when it does not.
+    material(c.ground.enabled ? glm::vec4(0.55f, 0.58f, 0.55f, 1.0f) : glm::vec4(0.55f, 0.58f, 0.55f, 0.35f), nullptr,
+             glm::vec2(1.0f), 0.05f, 16.0f);
+    lit_.set("u_grid", 1);
+    lit_.set("u_model", glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, c.ground.height, 0.0f)));
+    if (!c.ground.enabled) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+        glDepthMask(GL_FALSE);
+    }
+    ground_.draw();
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+
+    if (c.sphere.enabled) {
+        material({0.25f, 0.45f, 0.85f, 1.0f}, nullptr, glm::vec2(1.0f), 0.5f, 48.0f);
+        lit_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.sphere.center), glm::vec3(c.sphere.radius)));
+        sphere_.draw();
+    }
+    if (c.cube.enabled) {
+        material(glm::vec4(1.0f), &crate_, glm::vec2(1.0f), 0.35f, 32.0f);
+        lit_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
+        cube_.draw();
+    }
+    if (!input.view.wireframe && !input.sim.topology().triangles.empty()) {
+        material(input.view.texture ? glm::vec4(1.0f) : glm::vec4(0.80f, 0.36f, 0.26f, 1.0f),
+                 input.view.texture ? &fabric_ : nullptr, cloth_uv_scale_, 0.08f, 12.0f);
+        lit_.set("u_model", glm::mat4(1.0f));
+        cloth_->draw();
+    }
+}
+
+void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projection) {
+    const MassSpring& sim = input.sim;
+    const ViewSettings& view = input.view;
+    lines_.use();
+    lines_.set("u_view_projection", view_projection);
+    lines_.set("u_round_points", 0);
+    lines_.set("u_point_size", 1.0f);
+    glBindVertexArray(debug_vao_.get());
+    glBindBuffer(GL_ARRAY_BUFFER, debug_vbo_.get());
+    auto flush = [&](GLenum mode) {
+        if (debug_.empty()) return;
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(debug_.size() * sizeof(DebugVertex)), debug_.data(),
+                     GL_STREAM_DRAW);
+        glDrawArrays(mode, 0, static_cast<GLsizei>(debug_.size()));
+        debug_.clear();
+    };
+
+    if (view.wireframe) {
+        const glm::vec4 wire(0.95f, 0.55f, 0.35f, 1.0f);
+        for (const auto& t : sim.topology().triangles) {
+            for (int e = 0; e < 3; ++e) {
+                debug_.push_back({positions_[t[e]], wire});
+                debug_.push_back({positions_[t[(e + 1) % 3]], wire});
+            }
+        }
+        flush(GL_LINES);
+    }
+    if (view.springs != SpringView::Off) {
+        for (const Spring& s : sim.topology().springs) {
+            const glm::vec3 a = positions_[s.a], b = positions_[s.b];
+            glm::vec4 color = kind_color(s.kind);
+            if (view.springs == SpringView::ByStrain) {
+                const float strain = s.rest_length > 0.0f ? glm::length(b - a) / s.rest_length - 1.0f : 0.0f;
+                color = strain_color(strain, view.strain_range);
+            }
+            debug_.push_back({a, color});
+            debug_.push_back({b, color});
+        }
+        flush(GL_LINES);
+    }
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    lines_.set("u_round_points", 1);
+    // Points are drawn over the cloth so a pin or the grabbed particle is never hidden behind it.
+    glDisable(GL_DEPTH_TEST);
+    if (view.particles) {
+        lines_.set("u_point_size", 4.0f);
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) debug_.push_back({positions_[i], {0.1f, 0.1f, 0.1f, 1.0f}});
+        flush(GL_POINTS);
+    }
+    if (view.highlight_pins) {
+        lines_.set("u_point_size", 9.0f);
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+            if (sim.state().pinned[i] && i != input.grabbed) debug_.push_back({positions_[i], {0.9f, 0.1f, 0.1f, 1.0f}});
+        }
+        flush(GL_POINTS);
+    }
+    if (input.grabbed && *input.grabbed < positions_.size()) {
+        lines_.set("u_point_size", 12.0f);
+        debug_.push_back({positions_[*input.grabbed], {1.0f, 0.9f, 0.1f, 1.0f}});
+        flush(GL_POINTS);
+    }
+    glEnable(GL_DEPTH_TEST);
+}
+
+}  // namespace clothsim

@@ -1,0 +1,98 @@
+// The renderer: draws the cloth, the colliders and the ground with OpenGL 3.3 core. It only reads the
+// simulation (positions, topology, settings) and owns every GL object it creates.
+#pragma once
+
+#include "gl_objects.hpp"
+#include "meshes.hpp"
+#include "shader.hpp"
+
+#include "camera.hpp"
+#include "clothsim/mass_spring.hpp"
+
+#include <glm/mat4x4.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace clothsim {
+
+enum class SpringView { Off, ByKind, ByStrain };
+
+// What the View section of the panel toggles. Not part of a scene: how to look, not what to simulate.
+struct ViewSettings {
+    bool wireframe = false;       // W: cloth as wires instead of shaded
+    SpringView springs = SpringView::Off;
+    float strain_range = 0.1f;    // |strain| mapped to full colour when springs are coloured by strain
+    bool particles = false;
+    bool highlight_pins = true;
+    bool texture = true;
+    bool shadows = true;
+};
+
+// A static mesh on the GPU: positions, normals, UVs and triangle indices.
+class GpuMesh {
+public:
+    explicit GpuMesh(const MeshData& data, bool dynamic = false);
+    void update_positions_normals(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals);
+    void draw() const;
+
+private:
+    gl::VertexArray vao_;
+    gl::Buffer positions_, normals_, uvs_, indices_;
+    GLsizei index_count_ = 0;
+};
+
+struct RenderInput {
+    const MassSpring& sim;
+    const OrbitCamera& camera;
+    glm::ivec2 framebuffer_px;
+    glm::ivec4 viewport_px;  // x, y (from the bottom-left), width, height: the 3D view beside the panel
+    const ViewSettings& view;
+    std::optional<std::size_t> grabbed;
+};
+
+class Renderer {
+public:
+    // Loads the shaders and textures; throws gl::ShaderError or std::runtime_error naming the file.
+    Renderer(const std::filesystem::path& shader_dir, const std::filesystem::path& texture_dir);
+
+    // Must be called when the cloth's topology changes (a rebuild): re-creates the cloth's buffers.
+    void set_cloth(const MassSpring& sim);
+    void draw(const RenderInput& input);
+
+private:
+    void upload_cloth(const MassSpring& sim);
+    void draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection);
+    void draw_lit(const RenderInput& input, const glm::mat4& view_projection, const glm::mat4& light_view_projection);
+    void draw_debug(const RenderInput& input, const glm::mat4& view_projection);
+
+    gl::Shader lit_;
+    gl::Shader shadow_;
+    gl::Shader lines_;
+    gl::Texture fabric_;
+    gl::Texture crate_;
+    gl::Texture shadow_depth_;
+    gl::Framebuffer shadow_fbo_;
+    int shadow_size_ = 2048;
+
+    GpuMesh sphere_;
+    GpuMesh cube_;
+    GpuMesh ground_;
+    std::optional<GpuMesh> cloth_;
+    std::size_t cloth_particles_ = 0;
+    glm::vec2 cloth_uv_scale_{1.0f};
+    std::vector<glm::vec3> positions_, normals_;
+
+    // Debug lines and points: position + colour per vertex, rebuilt each frame they are shown.
+    gl::VertexArray debug_vao_;
+    gl::Buffer debug_vbo_;
+    struct DebugVertex {
+        glm::vec3 position;
+        glm::vec4 color;
+    };
+    std::vector<DebugVertex> debug_;
+};
+
+}  // namespace clothsim

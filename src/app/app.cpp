@@ -5,6 +5,7 @@
 #include "app_state.hpp"
 #include "camera.hpp"
 #include "gl.hpp"
+#include "layout.hpp"
 #include "picking.hpp"
 #include "renderer.hpp"
 #include "shader.hpp"
@@ -19,6 +20,7 @@
 #include <imgui.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -45,9 +47,7 @@ std::filesystem::path texture_directory() {
 
 // The 3D view: the window right of the panel, in window coordinates (x, y from the top-left, w, h).
 glm::vec4 view_rect(const AppState& app, const Window& window, float scale) {
-    const glm::vec2 size(window.window_size());
-    const float x = std::min(panel_width(app, scale), size.x - 1.0f);
-    return {x, 0.0f, std::max(size.x - x, 1.0f), std::max(size.y, 1.0f)};
+    return clothsim::view_rect(glm::vec2(window.window_size()), panel_width(app, scale));
 }
 
 float view_aspect(const AppState& app, const Window& window, float scale) {
@@ -62,8 +62,9 @@ void frame_camera(AppState& app, float aspect) {
 }
 
 void reset_camera(AppState& app, float aspect) {
-    app.camera = OrbitCamera{};
-    frame_camera(app, aspect);
+    glm::vec3 lo, hi;
+    scene_bounds(app.sim, lo, hi);
+    app.camera = framed_camera(lo, hi, aspect);
 }
 
 void record_energy(AppState& app) {
@@ -186,9 +187,24 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     if (io.MouseWheel != 0.0f) app.camera.zoom(io.MouseWheel);
 }
 
-void handle_keys(AppState& app, PanelRequests& requests) {
+// Key presses collected by a GLFW callback. ImGui 1.86 (before its 1.87 input queue) sees only the key
+// state at each frame, so a tap shorter than a frame would be lost; the queue keeps every press.
+struct KeyQueue {
+    std::vector<int> pressed;
+};
+
+void on_key(GLFWwindow* window, int key, int, int action, int) {
+    if (action != GLFW_PRESS) return;
+    if (auto* queue = static_cast<KeyQueue*>(glfwGetWindowUserPointer(window))) queue->pressed.push_back(key);
+}
+
+void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
+    const std::vector<int> pressed_keys = std::move(keys.pressed);
+    keys.pressed.clear();
     if (ImGui::GetIO().WantCaptureKeyboard) return;
-    auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
+    auto pressed = [&](int key) {
+        return std::find(pressed_keys.begin(), pressed_keys.end(), key) != pressed_keys.end();
+    };
     if (pressed(GLFW_KEY_SPACE)) app.paused = !app.paused;
     if (pressed(GLFW_KEY_S)) {
         app.paused = true;
@@ -313,6 +329,10 @@ int run_app(const Scene& scene, const AppOptions& options) {
     io.Fonts->AddFontDefault(&font);
     ImGui::StyleColorsDark();
     ImGui::GetStyle().ScaleAllSizes(scale);
+    // Installed before ImGui's, which chains to it.
+    KeyQueue keys;
+    glfwSetWindowUserPointer(window->get(), &keys);
+    glfwSetKeyCallback(window->get(), on_key);
     ImGui_ImplGlfw_InitForOpenGL(window->get(), true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
@@ -334,7 +354,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
         ImGui::NewFrame();
 
         PanelRequests requests;
-        handle_keys(app, requests);
+        handle_keys(app, keys, requests);
         handle_mouse(app, *window, scale);
 
         const auto now = Clock::now();
@@ -365,6 +385,17 @@ int run_app(const Scene& scene, const AppOptions& options) {
         app.stats.render_ms = std::chrono::duration<float, std::milli>(Clock::now() - render_start).count();
 
         ++frame;
+        // A GL error is a bug in the renderer: scripted runs (the tests) fail on it; interactive ones say so.
+        if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
+            char text[96];
+            std::snprintf(text, sizeof text, "OpenGL error 0x%04X in frame %lld", error, frame);
+            if (scripted) {
+                std::cerr << "clothsim: error: " << text << "\n";
+                exit_code = 4;
+                break;
+            }
+            app.say(text, true);
+        }
         if (scripted && frame >= *options.frames) {
             if (!options.screenshot.empty()) {
                 const std::string error = write_screenshot(options.screenshot, fb.x, fb.y);

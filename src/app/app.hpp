@@ -19,7 +19,8 @@ struct AppOptions {
     std::string screenshot;
 };
 
-// Returns the process exit code: 0, or 2 when no window / OpenGL 3.3 / shader / texture / screenshot file.
+// Returns the process exit code: 0; 2 when there is no window / OpenGL 3.3 / shader / texture / screenshot
+// file; 4 when a scripted run (--frames) hit an OpenGL error.
 int run_app(const Scene& scene, const AppOptions& options);
 
 // Writes the current back buffer (RGBA, bottom-up) as PNG; returns an error message or "".

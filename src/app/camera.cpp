@@ -52,6 +52,12 @@ void OrbitCamera::frame(glm::vec3 box_min, glm::vec3 box_max, float aspect) {
     distance = std::clamp(radius / std::sin(std::min(half_fov, half_fov_x)), 0.05f, 0.5f * far_plane);
 }
 
+OrbitCamera framed_camera(glm::vec3 box_min, glm::vec3 box_max, float aspect) {
+    OrbitCamera camera;
+    camera.frame(box_min, box_max, aspect);
+    return camera;
+}
+
 Ray ray_through(const OrbitCamera& camera, glm::vec2 cursor_px, glm::vec2 viewport_px) {
     const float aspect = viewport_px.x / std::max(viewport_px.y, 1.0f);
     // Normalised device coordinates: x right, y up, in [-1, 1].

@@ -33,6 +33,9 @@ struct OrbitCamera {
     void frame(glm::vec3 box_min, glm::vec3 box_max, float aspect);
 };
 
+// The camera the app starts with (and returns to on "reset camera"): the default direction, framing the box.
+OrbitCamera framed_camera(glm::vec3 box_min, glm::vec3 box_max, float aspect);
+
 struct Ray {
     glm::vec3 origin{0.0f};
     glm::vec3 direction{0.0f, 0.0f, -1.0f};  // unit

@@ -1,6 +1,6 @@
 // clothsim: command-line entry. Parses flags (CLI11), loads the scene and its --set overrides, then opens
 // the desktop app, or runs headless. Exit codes: 0 ok, 2 bad input (or no display / OpenGL 3.3),
-// 3 the simulation became non-finite.
+// 3 the simulation became non-finite, 4 an OpenGL error in a scripted (--frames) run.
 #include "app.hpp"
 #include "headless.hpp"
 

@@ -2,6 +2,7 @@
 // widget's tooltip gives the field's unit, meaning and allowed range, and each field can be reset to the
 // loaded scene's value or the built-in default (right-click, or the small button that appears once changed).
 #include "app_state.hpp"
+#include "layout.hpp"
 
 #include <imgui.h>
 
@@ -207,7 +208,9 @@ void help_section() {
 
 }  // namespace
 
-float panel_width(const AppState& app, float content_scale) { return app.show_panel ? 360.0f * content_scale : 0.0f; }
+float panel_width(const AppState& app, float content_scale) {
+    return app.show_panel ? kPanelWidth * content_scale : 0.0f;
+}
 
 PanelRequests draw_panel(AppState& app, float content_scale) {
     PanelRequests requests;

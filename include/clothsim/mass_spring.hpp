@@ -84,8 +84,9 @@ private:
     double carry_ = 0.0;     // s: time advance() has not yet stepped
 };
 
-// The box around the cloth's finite particles and the enabled sphere and cube (for cameras and shadows).
-// An empty or all-NaN cloth gives the box at the origin.
+// The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it
+// is enabled (where a falling cloth ends up): what the camera frames and the shadow map covers. An empty
+// or all-NaN cloth gives the box at the origin (and the ground).
 void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi);
 
 }  // namespace clothsim

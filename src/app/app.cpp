@@ -338,7 +338,10 @@ int run_app(const Scene& scene, const AppOptions& options) {
 
     AppState app(scene, options.scene_source);
     app.save_path = scene.name + "-edited.toml";
-    app.open_path = "assets/scenes/hanging.toml";
+    app.open_path = std::filesystem::absolute(options.scene_source.ends_with(".toml")
+                                                  ? std::filesystem::path(options.scene_source)
+                                                  : scene_directory() / (options.scene_source + ".toml"))
+                        .string();
     renderer->set_cloth(app.sim);
     reset_camera(app, view_aspect(app, *window, scale));
     record_energy(app);

@@ -7,6 +7,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -167,6 +168,10 @@ void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi) {
         hi = glm::max(hi, c.cube.center + 0.5f * c.cube.size);
     }
     if (!(lo.x <= hi.x)) lo = hi = glm::vec3(0.0f);
+    if (c.ground.enabled) {
+        lo.y = std::min(lo.y, c.ground.height);
+        hi.y = std::max(hi.y, c.ground.height);
+    }
 }
 
 }  // namespace clothsim

@@ -161,7 +161,6 @@ void Renderer::draw(const RenderInput& input) {
 
     glm::vec3 lo, hi;
     scene_bounds(input.sim, lo, hi);
-    lo.y = std::min(lo.y, input.sim.settings().colliders.ground.height);
     const glm::vec3 center = 0.5f * (lo + hi);
     const float radius = std::max(0.5f * glm::length(hi - lo), 0.5f) * 1.2f;
     const glm::mat4 light_view =

@@ -35,7 +35,8 @@ TEST_CASE("readme lists every bundled scene and flag", "[readme]") {
         CHECK(text.find("| `" + name + "` |") != std::string::npos);
     }
     for (const char* flag : {"--headless", "--scene", "--duration", "--steps", "--set", "--trajectory", "--every",
-                             "--obj", "--json", "--list-scenes", "--list-fields", "--print-scene"}) {
+                             "--obj", "--json", "--list-scenes", "--list-fields", "--print-scene", "--frames", "--screenshot",
+                             "--size"}) {
         INFO(flag);
         CHECK(text.find(std::string("`") + flag) != std::string::npos);
     }

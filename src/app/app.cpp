@@ -273,6 +273,19 @@ void apply_requests(AppState& app, Renderer& renderer, const Window& window, flo
 
 }  // namespace
 
+bool apply_view_option(ViewSettings& view, bool& show_panel, const std::string& item) {
+    if (item == "wireframe") view.wireframe = true;
+    else if (item == "springs=kind") view.springs = SpringView::ByKind;
+    else if (item == "springs=strain") view.springs = SpringView::ByStrain;
+    else if (item == "particles") view.particles = true;
+    else if (item == "no-pins") view.highlight_pins = false;
+    else if (item == "no-texture") view.texture = false;
+    else if (item == "no-shadows") view.shadows = false;
+    else if (item == "no-panel") show_panel = false;
+    else return false;
+    return true;
+}
+
 std::string timestamped_screenshot_name() {
     const std::time_t now = std::time(nullptr);
     char name[64];
@@ -337,6 +350,8 @@ int run_app(const Scene& scene, const AppOptions& options) {
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     AppState app(scene, options.scene_source);
+    app.view = options.view;
+    app.show_panel = options.show_panel;
     app.save_path = scene.name + "-edited.toml";
     app.open_path = std::filesystem::absolute(options.scene_source.ends_with(".toml")
                                                   ? std::filesystem::path(options.scene_source)

@@ -1,6 +1,8 @@
 // The desktop app: a window, the renderer and the settings panel around one MassSpring.
 #pragma once
 
+#include "renderer.hpp"
+
 #include "clothsim/settings.hpp"
 
 #include <glm/vec2.hpp>
@@ -17,7 +19,12 @@ struct AppOptions {
     // clock says), write the last one to `screenshot` (panel included) and exit.
     std::optional<long long> frames;
     std::string screenshot;
+    ViewSettings view;       // the View section's start values (--view)
+    bool show_panel = true;
 };
+
+// Applies one --view item ("wireframe", "springs=strain", "no-shadows", ...); false if unknown.
+bool apply_view_option(ViewSettings& view, bool& show_panel, const std::string& item);
 
 // Returns the process exit code: 0; 2 when there is no window / OpenGL 3.3 / shader / texture / screenshot
 // file; 4 when a scripted run (--frames) hit an OpenGL error.

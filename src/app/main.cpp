@@ -47,6 +47,11 @@ int main(int argc, char** argv) {
     app.add_option("--screenshot", app_options.screenshot, "App: with --frames, write the last frame as PNG")
         ->needs(frames);
     app.add_option("--size", size_text, "App: window size WxH in screen coordinates (default 1280x720)");
+    std::vector<std::string> view_items;
+    app.add_option("--view", view_items,
+                   "App: start with these view options (comma-separated): wireframe, springs=kind, springs=strain, "
+                   "particles, no-pins, no-texture, no-shadows, no-panel")
+        ->delimiter(',');
 
     try {
         app.parse(argc, argv);
@@ -87,6 +92,14 @@ int main(int argc, char** argv) {
                 return kExitBadInput;
             }
             app_options.size = {w, h};
+        }
+        for (const std::string& item : view_items) {
+            if (!apply_view_option(app_options.view, app_options.show_panel, item)) {
+                std::cerr << "clothsim: error: --view " << item
+                          << ": unknown view option; allowed: wireframe, springs=kind, springs=strain, particles, "
+                             "no-pins, no-texture, no-shadows, no-panel\n";
+                return kExitBadInput;
+            }
         }
         app_options.scene_source = scene_name;
         return run_app(scene, app_options);

@@ -266,7 +266,24 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
         requests.rebuild |= fields_section(app, "pins");
     }
     if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(app, "springs.");
-    if (ImGui::CollapsingHeader("Forces")) fields_section(app, "forces.");
+    if (ImGui::CollapsingHeader("Forces")) {
+        fields_section(app, "forces.");
+        // Strength and direction as a user thinks of them; both edit forces.wind.
+        glm::vec3& wind = app.scene.settings.forces.wind;
+        float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
+        const float old_speed = speed;
+        if (ImGui::SliderFloat("wind speed", &speed, 0.0f, 50.0f, "%.2f m/s")) {
+            wind = old_speed > 0.0f ? wind * (speed / old_speed) : glm::vec3(speed, 0.0f, 0.0f);
+        }
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("|forces.wind| in m/s; keeps the direction");
+        float heading = std::atan2(wind.z, wind.x) * 57.29578f;
+        if (speed > 0.0f && ImGui::SliderFloat("wind heading", &heading, -180.0f, 180.0f, "%.0f deg")) {
+            const float horizontal = std::sqrt(wind.x * wind.x + wind.z * wind.z);
+            wind.x = horizontal * std::cos(heading / 57.29578f);
+            wind.z = horizontal * std::sin(heading / 57.29578f);
+        }
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
+    }
     if (ImGui::CollapsingHeader("Integration")) {
         fields_section(app, "integration.");
         ImGui::Text("substep %.4g ms", 1000.0 * app.scene.settings.integration.dt / app.scene.settings.integration.substeps);

@@ -581,3 +581,46 @@ TEST_CASE("render error: --screenshot into a missing directory exits 2 and write
     CHECK_FALSE(fs::exists(target));
     CHECK_FALSE(fs::exists(target.parent_path()));
 }
+
+TEST_CASE("render error: without OpenGL 3.3 the app says so and exits 2") {
+    const TempDir dir("no_gl33");
+    // Mesa offers only what MESA_GL_VERSION_OVERRIDE says: a 3.0 driver cannot give a 3.3 core context.
+    const RunResult r = run_clothsim(dir, {"--scene", "hanging", "--frames", "1", "--size", kSize},
+                                     {"MESA_GL_VERSION_OVERRIDE=3.0"});
+    CAPTURE_RUN(r);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("clothsim: error:") && Contains("OpenGL 3.3") && Contains("--headless"));
+}
+
+TEST_CASE("render debug views: wireframe, springs by kind and by strain, particles draw without a GL error") {
+    const TempDir dir("debug_views");
+    const fs::path shaded_png = dir / "shaded.png";
+    const RunResult shaded = run_clothsim(dir, {"--scene", "hanging", "--frames", "20", "--size", kSize,
+                                                "--view", "no-panel", "--screenshot", shaded_png.string()});
+    CAPTURE_RUN(shaded);
+    REQUIRE(shaded.code == 0);
+    const Image base = load_png(shaded_png);
+    for (const char* view : {"wireframe,no-panel", "springs=kind,no-panel", "springs=strain,no-panel",
+                             "particles,no-panel"}) {
+        INFO("--view " << view);
+        const fs::path png = dir / "view.png";
+        const RunResult r = run_clothsim(dir, {"--scene", "hanging", "--frames", "20", "--size", kSize, "--view",
+                                               view, "--screenshot", png.string()});
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        const Image img = load_png(png);
+        REQUIRE(img.width == base.width);
+        // The same simulation drawn another way: many pixels differ from the shaded picture.
+        long long differing = 0;
+        for (int y = 0; y < img.height; ++y) {
+            for (int x = 0; x < img.width; ++x) {
+                const Rgb a = img.at(x, y), b = base.at(x, y);
+                differing += std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b) > 60;
+            }
+        }
+        CHECK(differing > 2000);
+    }
+    const RunResult bad = run_clothsim(dir, {"--frames", "1", "--view", "sparkles"});
+    CHECK(bad.code == 2);
+    CHECK_THAT(bad.err, Contains("--view sparkles") && Contains("wireframe"));
+}

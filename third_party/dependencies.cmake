@@ -4,6 +4,7 @@
 find_package(glm REQUIRED)                    # libglm-dev: vector maths, header only
 find_package(tomlplusplus 3 REQUIRED)         # libtomlplusplus-dev: scene files
 find_package(nlohmann_json 3 REQUIRED)        # nlohmann-json3-dev: --json output
+find_package(OpenMP REQUIRED COMPONENTS CXX)  # libgomp (with g++): the fast solver's threads
 
 if(CLOTHSIM_BUILD_APP)
   find_package(CLI11 2 REQUIRED)              # libcli11-dev: command-line parsing

@@ -21,9 +21,16 @@ float signed_distance(const SphereCollider& sphere, glm::vec3 p);
 float signed_distance(const CubeCollider& cube, glm::vec3 p);
 float signed_distance(const GroundCollider& ground, glm::vec3 p);
 
-// Collision stages. Pinned particles are never moved.
-void collide(State& state, const SphereCollider& sphere, float thickness);
-void collide(State& state, const CubeCollider& cube, float thickness);
-void collide(State& state, const GroundCollider& ground, float thickness);
+// Collision stages for particles [begin, end) (all by default). Pinned particles are never moved.
+inline constexpr std::size_t kAllParticles = static_cast<std::size_t>(-1);
+void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin = 0,
+             std::size_t end = kAllParticles);
+void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin = 0,
+             std::size_t end = kAllParticles);
+void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
+             std::size_t end = kAllParticles);
+// Every enabled collider, in the order sphere, cube, ground.
+void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
+                 std::size_t end = kAllParticles);
 
 }  // namespace clothsim

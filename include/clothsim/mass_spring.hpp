@@ -13,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -26,12 +27,19 @@ struct Energy {
     double total() const { return kinetic + potential(); }
 };
 
+class GridSolver;
+
 class MassSpring {
 public:
     // `state.position` holds the start positions; `initial_velocity` (one per particle, or empty for rest)
     // sets the start velocities. Previous positions are derived from them (second-order start).
     MassSpring(Topology topology, State state, SimulationSettings settings,
                const std::vector<glm::vec3>& initial_velocity = {});
+    ~MassSpring();
+    MassSpring(const MassSpring& other);
+    MassSpring& operator=(const MassSpring& other);
+    MassSpring(MassSpring&&) noexcept;
+    MassSpring& operator=(MassSpring&&) noexcept;
 
     // One integration substep of length substep_length().
     void step();
@@ -61,6 +69,12 @@ public:
     Energy energy() const;
     glm::vec3 momentum() const;  // kg m/s, free particles
     bool all_finite() const;
+    // Whether settings().solver.method == Fast really runs the fast grid solver (it needs a grid topology),
+    // and with how many threads.
+    bool fast_solver_available() const { return grid_ != nullptr; }
+    int solver_threads() const;
+    // The fast solver's spring kernel on this CPU: "avx2+fma" or "generic" (chosen at run time).
+    static const char* fast_kernel_name();
 
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
@@ -75,10 +89,12 @@ private:
     // when the substep length changes, so a new dt does not turn into a velocity jump).
     void restart(const std::vector<glm::vec3>& velocity, float h);
     void compute_forces(const State& state, Vec3Array& force) const;
+    bool wind_active() const;
 
     Topology topology_;
     State state_;
     SimulationSettings settings_;
+    std::unique_ptr<GridSolver> grid_;  // the fast solver, when the topology is a grid
     Vec3Array force_;        // N, scratch of the current substep
     float rest_area_ = 0.0f; // m^2: sum of the triangles' rest areas
     double carry_ = 0.0;     // s: time advance() has not yet stepped

@@ -17,6 +17,12 @@ namespace clothsim {
 // Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
 
+// Which implementation advances the cloth. Both integrate the same model; see src/core/grid_solver.hpp.
+enum class SolverMethod {
+    Fast,      // row sweeps over the grid: vectorised, multi-threaded, each spring once, stages fused
+    Textbook,  // one loop over the spring list, one over the particles: the oracle the tests compare with
+};
+
 // How wind acts on the cloth.
 enum class WindModel {
     Triangles,  // pressure on each triangle along its normal: an edge-on sheet feels none, a flag flutters
@@ -89,12 +95,18 @@ struct IntegrationSettings {
     int substeps = 25;        // integration substeps per step; each advances dt / substeps
 };
 
+struct SolverSettings {
+    SolverMethod method = SolverMethod::Fast;
+    int threads = 0;  // worker threads for the fast solver; 0 = one per core
+};
+
 // The settings a running simulation reads every step; all of them may change live.
 struct SimulationSettings {
     SpringSettings springs;
     ForceSettings forces;
     ColliderSettings colliders;
     IntegrationSettings integration;
+    SolverSettings solver;
 };
 
 // Everything a scene file holds. Changing cloth or pins needs a rebuild; the rest applies live.

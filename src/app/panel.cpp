@@ -127,6 +127,21 @@ bool field_widget(AppState& app, const FieldInfo& f) {
                 }
                 return edited;
             },
+            [&](SolverMethod* v) {
+                int method = static_cast<int>(*v);
+                const auto names = solver_method_names();
+                bool edited = false;
+                if (ImGui::BeginCombo(label.c_str(), std::string(names[method]).c_str())) {
+                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == method)) {
+                            *v = static_cast<SolverMethod>(i);
+                            edited = true;
+                        }
+                    }
+                    ImGui::EndCombo();
+                }
+                return edited;
+            },
             [&](WindModel* v) {
                 int model = static_cast<int>(*v);
                 const auto names = wind_model_names();
@@ -286,6 +301,7 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     }
     if (ImGui::CollapsingHeader("Integration")) {
         fields_section(app, "integration.");
+        fields_section(app, "solver.");
         ImGui::Text("substep %.4g ms", 1000.0 * app.scene.settings.integration.dt / app.scene.settings.integration.substeps);
         ImGui::SliderInt("max catch-up steps", &app.max_catchup_steps, 1, 16);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");

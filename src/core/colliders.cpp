@@ -51,9 +51,40 @@ Contact contact(const GroundCollider& ground, glm::vec3 p, float thickness) {
     return {glm::vec3(0.0f, 1.0f, 0.0f), ground.height + thickness - p.y};
 }
 
+// Cheap tests, written so the compiler vectorises them, of whether any particle of a range is close
+// enough to need the full contact: most rows of a cloth touch nothing, and then cost one pass of compares.
+bool any_near(const State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
+    const float reach = (sphere.radius + thickness) * (sphere.radius + thickness);
+    bool any = false;
+    for (std::size_t i = begin; i < end; ++i) {
+        const float dx = state.position.x[i] - sphere.center.x, dy = state.position.y[i] - sphere.center.y,
+                    dz = state.position.z[i] - sphere.center.z;
+        any |= dx * dx + dy * dy + dz * dz < reach;
+    }
+    return any;
+}
+bool any_near(const State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
+    const glm::vec3 lo = cube.center - 0.5f * cube.size - thickness, hi = cube.center + 0.5f * cube.size + thickness;
+    bool any = false;
+    for (std::size_t i = begin; i < end; ++i) {
+        const float x = state.position.x[i], y = state.position.y[i], z = state.position.z[i];
+        any |= (x > lo.x) & (x < hi.x) & (y > lo.y) & (y < hi.y) & (z > lo.z) & (z < hi.z);
+    }
+    return any;
+}
+bool any_near(const State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
+    const float top = ground.height + thickness;
+    bool any = false;
+    for (std::size_t i = begin; i < end; ++i) any |= state.position.y[i] < top;
+    return any;
+}
+
 template <class Shape>
-void collide_shape(State& state, const Shape& shape, float friction, float thickness) {
-    for (std::size_t i = 0; i < state.size(); ++i) {
+void collide_shape(State& state, const Shape& shape, float friction, float thickness, std::size_t begin,
+                   std::size_t end) {
+    // NaN positions fail every compare above; they stay NaN either way (the guard reports them).
+    if (!any_near(state, shape, thickness, begin, end)) return;
+    for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
         const Contact c = contact(shape, state.position.get(i), thickness);
         if (!(c.depth > 0.0f)) continue;
@@ -85,14 +116,20 @@ float signed_distance(const CubeCollider& cube, glm::vec3 p) {
 
 float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
 
-void collide(State& state, const SphereCollider& sphere, float thickness) {
-    collide_shape(state, sphere, sphere.friction, thickness);
+void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
+    collide_shape(state, sphere, sphere.friction, thickness, begin, std::min(end, state.size()));
 }
-void collide(State& state, const CubeCollider& cube, float thickness) {
-    collide_shape(state, cube, cube.friction, thickness);
+void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
+    collide_shape(state, cube, cube.friction, thickness, begin, std::min(end, state.size()));
 }
-void collide(State& state, const GroundCollider& ground, float thickness) {
-    collide_shape(state, ground, ground.friction, thickness);
+void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
+    collide_shape(state, ground, ground.friction, thickness, begin, std::min(end, state.size()));
+}
+
+void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
+    if (colliders.sphere.enabled) collide(state, colliders.sphere, colliders.thickness, begin, end);
+    if (colliders.cube.enabled) collide(state, colliders.cube, colliders.thickness, begin, end);
+    if (colliders.ground.enabled) collide(state, colliders.ground, colliders.thickness, begin, end);
 }
 
 }  // namespace clothsim

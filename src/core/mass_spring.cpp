@@ -2,6 +2,7 @@
 
 #include "clothsim/colliders.hpp"
 #include "forces.hpp"
+#include "grid_solver.hpp"
 #include "verlet.hpp"
 
 #include <glm/common.hpp>
@@ -27,36 +28,68 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     }
     force_.resize(n);
     state_.motion.resize(n);
+    if (auto grid = GridSolver::for_topology(topology_)) grid_ = std::make_unique<GridSolver>(std::move(*grid));
     restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
             substep_length());
+}
+
+MassSpring::~MassSpring() = default;
+MassSpring::MassSpring(MassSpring&&) noexcept = default;
+MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
+MassSpring::MassSpring(const MassSpring& other)
+    : topology_(other.topology_),
+      state_(other.state_),
+      settings_(other.settings_),
+      grid_(other.grid_ ? std::make_unique<GridSolver>(*other.grid_) : nullptr),
+      force_(other.force_),
+      rest_area_(other.rest_area_),
+      carry_(other.carry_) {}
+MassSpring& MassSpring::operator=(const MassSpring& other) {
+    if (this != &other) *this = MassSpring(other);
+    return *this;
+}
+
+const char* MassSpring::fast_kernel_name() { return GridSolver::kernel_name(); }
+
+int MassSpring::solver_threads() const {
+    return grid_ && settings_.solver.method == SolverMethod::Fast ? grid_->effective_threads(settings_.solver.threads)
+                                                                   : 1;
 }
 
 float MassSpring::substep_length() const {
     return settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
 }
 
-// The whole pipeline of one substep, in order.
+// The whole pipeline of one substep, in order: forces (springs, wind), integration (gravity and damping
+// inside), collisions. The fast solver runs the same stages fused row by row (grid_solver.hpp says why).
 void MassSpring::step() {
     const float h = substep_length();
     if (h != state_.substep) restart(velocities(), h);
 
-    compute_forces(state_, force_);
-    integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
-    const ColliderSettings& colliders = settings_.colliders;
-    if (colliders.sphere.enabled) collide(state_, colliders.sphere, colliders.thickness);
-    if (colliders.cube.enabled) collide(state_, colliders.cube, colliders.thickness);
-    if (colliders.ground.enabled) collide(state_, colliders.ground, colliders.thickness);
-
+    if (grid_ && settings_.solver.method == SolverMethod::Fast) {
+        const Vec3Array* external = nullptr;
+        if (wind_active()) {
+            force_.resize(state_.size());
+            accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
+            external = &force_;
+        }
+        grid_->step(state_, settings_, external, h, settings_.solver.threads);
+    } else {
+        compute_forces(state_, force_);
+        integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+        collide_all(state_, settings_.colliders);
+    }
     state_.time += h;
+}
+
+bool MassSpring::wind_active() const {
+    return settings_.forces.wind != glm::vec3(0.0f) || settings_.forces.wind_model == WindModel::Uniform;
 }
 
 void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
     force.resize(state.size());
     accumulate_spring_forces(topology_, state.position, settings_.springs, force);
-    const ForceSettings& forces = settings_.forces;
-    if (forces.wind != glm::vec3(0.0f) || forces.wind_model == WindModel::Uniform) {
-        accumulate_wind_forces(topology_, state, forces, rest_area_, force);
-    }
+    if (wind_active()) accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, force);
 }
 
 void MassSpring::run_steps(long long steps) {

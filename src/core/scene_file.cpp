@@ -166,6 +166,12 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
                 *target = *v;
                 return true;
             },
+            [&](SolverMethod* target) {
+                const auto v = enum_of<SolverMethod>(node, solver_method_names());
+                if (!v) return false;
+                *target = *v;
+                return true;
+            },
         },
         field.ref(scene));
 }

@@ -3,9 +3,7 @@
 namespace clothsim {
 
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h) {
-    const float half_ch = 0.5f * damping * h;
-    const float keep = 1.0f - damping * h / (1.0f + half_ch);  // 1 - d
-    const float h2 = h * h / (1.0f + half_ch);
+    const auto [keep, h2] = verlet_coefficients(damping, h);
     const std::size_t n = state.size();
     Vec3Array& x = state.position;
     Vec3Array& motion = state.motion;

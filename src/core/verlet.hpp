@@ -16,6 +16,16 @@
 
 namespace clothsim {
 
+// The per-substep constants of the update x' - x = (x - x_prev) keep + a h2, shared by every solver.
+struct VerletCoefficients {
+    float keep;  // 1 - d, d = c h / (1 + c h/2)
+    float h2;    // h^2 / (1 + c h/2)
+};
+inline VerletCoefficients verlet_coefficients(float damping, float h) {
+    const float half_ch = 0.5f * damping * h;
+    return {1.0f - damping * h / (1.0f + half_ch), h * h / (1.0f + half_ch)};
+}
+
 // One substep of length h for every free particle; pinned particles stay where they are.
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h);
 

@@ -1,0 +1,192 @@
+// clothsim-bench: throughput of the fast solver against the textbook one, and the frame budget.
+//
+// Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
+// median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
+#include "clothsim/normals.hpp"
+#include "clothsim/scene.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using namespace clothsim;
+using Clock = std::chrono::steady_clock;
+
+Scene grid_scene(const std::string& base, int size, SolverMethod method, int threads) {
+    Scene s = load_scene(base);
+    s.cloth.rows = size;
+    s.cloth.cols = size;
+    s.settings.solver.method = method;
+    s.settings.solver.threads = threads;
+    return s;
+}
+
+// Median wall time of one call of `work`, over `repeats` timed runs each at least `min_seconds` long.
+template <class Work>
+double median_seconds(Work&& work, int repeats, double min_seconds) {
+    long long calls = 1;
+    for (;;) {  // calibrate so one repetition is long enough to time
+        const auto t0 = Clock::now();
+        for (long long i = 0; i < calls; ++i) work();
+        const double t = std::chrono::duration<double>(Clock::now() - t0).count();
+        if (t >= min_seconds) break;
+        calls = std::max(calls * 2, static_cast<long long>(calls * min_seconds / std::max(t, 1e-9)));
+    }
+    std::vector<double> samples;
+    for (int r = 0; r < repeats; ++r) {
+        const auto t0 = Clock::now();
+        for (long long i = 0; i < calls; ++i) work();
+        samples.push_back(std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(calls));
+    }
+    std::sort(samples.begin(), samples.end());
+    return samples[samples.size() / 2];
+}
+
+// Bytes of per-particle simulation state the step touches: position and motion (6 floats), inverse mass,
+// mass and the pin flag, plus the fast solver's six rest lengths.
+double state_bytes_per_particle(SolverMethod method) {
+    const double common = 6 * 4 + 4 + 4 + 1;
+    return method == SolverMethod::Fast ? common + 6 * 4 : common;
+}
+
+struct Row {
+    int size = 0;
+    std::size_t particles = 0, springs = 0;
+    std::string method;
+    int threads = 1;
+    double seconds_per_step = 0;
+    double speedup = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"clothsim-bench: solver throughput and frame budget"};
+    std::vector<int> sizes{32, 64, 128, 256, 512};
+    std::vector<int> thread_counts{1, 2};
+    std::string scene = "hanging", csv_path, json_path;
+    int repeats = 7;
+    double min_seconds = 0.05;
+    double budget_ms = 8.0;
+    app.add_option("--sizes", sizes, "Grid sizes (particles per side)")->delimiter(',');
+    app.add_option("--threads", thread_counts, "Thread counts for the fast solver")->delimiter(',');
+    app.add_option("--scene", scene, "Base scene (its cloth is resized)")->capture_default_str();
+    app.add_option("--repeats", repeats, "Timed repetitions per case (the median is reported)")->capture_default_str();
+    app.add_option("--min-seconds", min_seconds, "Minimum length of one repetition")->capture_default_str();
+    app.add_option("--budget-ms", budget_ms, "Frame budget for the substeps-per-frame figure")->capture_default_str();
+    app.add_option("--csv", csv_path, "Write the table as CSV");
+    app.add_option("--json", json_path, "Write the table and the frame budget as JSON");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+
+    std::vector<Row> rows;
+    try {
+        for (int size : sizes) {
+            double textbook = 0;
+            {
+                MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Textbook, 1));
+                textbook = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+                rows.push_back({size, sim.particle_count(), sim.spring_count(), "textbook", 1, textbook, 1.0});
+            }
+            for (int t : thread_counts) {
+                MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Fast, t));
+                const double fast = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+                rows.push_back({size, sim.particle_count(), sim.spring_count(), "fast", sim.solver_threads(), fast,
+                                textbook / fast});
+            }
+        }
+    } catch (const SceneError& e) {
+        std::cerr << "clothsim-bench: error: " << e.what() << "\n";
+        return 2;
+    }
+
+    // The frame budget: whole substeps of the fast solver (all threads) that fit in budget_ms beside what the
+    // renderer needs from the core every frame (positions and vertex normals).
+    struct Budget {
+        int size;
+        double substep_ms, render_prep_ms;
+        long long substeps;
+    };
+    std::vector<Budget> budgets;
+    for (int size : {128, 256}) {
+        MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Fast, 0));
+        const double substep = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+        std::vector<glm::vec3> normals, positions;
+        const double prep = median_seconds(
+            [&] {
+                positions = sim.positions();
+                compute_vertex_normals(sim.topology(), sim.state().position, normals);
+            },
+            repeats, min_seconds);
+        const double left = budget_ms * 1e-3 - prep;
+        budgets.push_back({size, 1e3 * substep, 1e3 * prep, left > 0 ? static_cast<long long>(left / substep) : 0});
+    }
+
+    std::printf("%6s %9s %9s %9s %7s %12s %12s %12s %10s %8s\n", "size", "particles", "springs", "method", "threads",
+                "ns/particle", "ns/spring", "steps/s", "B/particle", "speedup");
+    for (const Row& r : rows) {
+        const SolverMethod m = r.method == "fast" ? SolverMethod::Fast : SolverMethod::Textbook;
+        std::printf("%6d %9zu %9zu %9s %7d %12.3f %12.4f %12.0f %10.0f %8.2f\n", r.size, r.particles, r.springs,
+                    r.method.c_str(), r.threads, 1e9 * r.seconds_per_step / r.particles,
+                    1e9 * r.seconds_per_step / r.springs, 1.0 / r.seconds_per_step, state_bytes_per_particle(m),
+                    r.speedup);
+    }
+    std::printf("\nfast solver kernel: %s\n", MassSpring::fast_kernel_name());
+    std::printf("frame budget %.1f ms (fast solver, %d threads):\n", budget_ms,
+                build_simulation(grid_scene(scene, 32, SolverMethod::Fast, 0)).solver_threads());
+    for (const Budget& b : budgets) {
+        std::printf("  %dx%d: substep %.4f ms, positions + normals %.4f ms -> %lld substeps per frame\n", b.size,
+                    b.size, b.substep_ms, b.render_prep_ms, b.substeps);
+    }
+    if (!json_path.empty()) {
+        nlohmann::json j;
+        j["kernel"] = MassSpring::fast_kernel_name();
+        for (const Row& r : rows) {
+            j["rows"].push_back({{"size", r.size}, {"particles", r.particles}, {"springs", r.springs},
+                                 {"method", r.method}, {"threads", r.threads},
+                                 {"ns_per_particle_step", 1e9 * r.seconds_per_step / r.particles},
+                                 {"ns_per_spring_step", 1e9 * r.seconds_per_step / r.springs},
+                                 {"steps_per_second", 1.0 / r.seconds_per_step},
+                                 {"speedup_vs_textbook", r.speedup}});
+        }
+        for (const Budget& b : budgets) {
+            j["frame_budget"].push_back({{"size", b.size}, {"budget_ms", budget_ms}, {"substep_ms", b.substep_ms},
+                                         {"render_prep_ms", b.render_prep_ms}, {"substeps", b.substeps}});
+        }
+        std::ofstream out(json_path);
+        out << j.dump(2) << "\n";
+        if (!out) {
+            std::cerr << "clothsim-bench: error: cannot write " << json_path << "\n";
+            return 2;
+        }
+    }
+    if (!csv_path.empty()) {
+        std::ofstream out(csv_path);
+        out << "size,particles,springs,method,threads,ns_per_particle_step,ns_per_spring_step,steps_per_second,"
+               "state_bytes_per_particle,speedup_vs_textbook\n";
+        for (const Row& r : rows) {
+            const SolverMethod m = r.method == "fast" ? SolverMethod::Fast : SolverMethod::Textbook;
+            out << r.size << ',' << r.particles << ',' << r.springs << ',' << r.method << ',' << r.threads << ','
+                << 1e9 * r.seconds_per_step / r.particles << ',' << 1e9 * r.seconds_per_step / r.springs << ','
+                << 1.0 / r.seconds_per_step << ',' << state_bytes_per_particle(m) << ',' << r.speedup << '\n';
+        }
+        if (!out) {
+            std::cerr << "clothsim-bench: error: cannot write " << csv_path << "\n";
+            return 2;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,100 @@
+// Google Benchmark microbenchmarks of the step's kernels, on the hanging scene at several grid sizes:
+// the textbook spring loop, one fast-solver substep (springs + integration + collisions fused), the
+// textbook Verlet update, collisions with a sphere the cloth lies on, and the renderer's vertex normals.
+#include "clothsim/colliders.hpp"
+#include "clothsim/normals.hpp"
+#include "clothsim/scene.hpp"
+#include "forces.hpp"
+#include "verlet.hpp"
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace clothsim;
+
+MassSpring hanging(int size, SolverMethod method, int threads) {
+    Scene s = load_scene("hanging");
+    s.cloth.rows = size;
+    s.cloth.cols = size;
+    s.settings.solver.method = method;
+    s.settings.solver.threads = threads;
+    return build_simulation(s);
+}
+
+void set_counters(benchmark::State& state, const MassSpring& sim) {
+    state.counters["particles"] = static_cast<double>(sim.particle_count());
+    state.counters["springs/s"] = benchmark::Counter(static_cast<double>(sim.spring_count()),
+                                                     benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_TextbookSpringForces(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
+    Vec3Array force;
+    for (auto _ : state) {
+        force.resize(sim.particle_count());
+        accumulate_spring_forces(sim.topology(), sim.state().position, sim.settings().springs, force);
+        benchmark::DoNotOptimize(force.x.data());
+    }
+    set_counters(state, sim);
+}
+
+void BM_FastSubstep(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Fast, static_cast<int>(state.range(1)));
+    for (auto _ : state) sim.step();
+    set_counters(state, sim);
+}
+
+void BM_TextbookSubstep(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
+    for (auto _ : state) sim.step();
+    set_counters(state, sim);
+}
+
+void BM_IntegrateVerlet(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
+    State st = sim.state();
+    Vec3Array force;
+    force.resize(st.size());
+    for (auto _ : state) {
+        integrate_verlet(st, force, {0.0f, -9.81f, 0.0f}, 0.2f, 1e-4f);
+        benchmark::DoNotOptimize(st.position.x.data());
+    }
+    state.counters["particles/s"] =
+        benchmark::Counter(static_cast<double>(st.size()), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_CollideSphere(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
+    State st = sim.state();
+    // A sphere through the middle of the cloth: about half the rows are near it.
+    SphereCollider sphere{true, st.position.get(st.size() / 2), 0.3f, 0.3f};
+    for (auto _ : state) {
+        collide(st, sphere, 0.005f);
+        benchmark::DoNotOptimize(st.position.x.data());
+    }
+    state.counters["particles/s"] =
+        benchmark::Counter(static_cast<double>(st.size()), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_VertexNormals(benchmark::State& state) {
+    MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Fast, 1);
+    std::vector<glm::vec3> normals;
+    for (auto _ : state) {
+        compute_vertex_normals(sim.topology(), sim.state().position, normals);
+        benchmark::DoNotOptimize(normals.data());
+    }
+    state.counters["particles/s"] = benchmark::Counter(static_cast<double>(sim.particle_count()),
+                                                       benchmark::Counter::kIsIterationInvariantRate);
+}
+
+}  // namespace
+
+BENCHMARK(BM_TextbookSpringForces)->Arg(64)->Arg(128)->Arg(256);
+BENCHMARK(BM_TextbookSubstep)->Arg(64)->Arg(128)->Arg(256);
+BENCHMARK(BM_FastSubstep)->Args({64, 1})->Args({128, 1})->Args({256, 1})->Args({128, 2})->Args({256, 2})->UseRealTime();
+BENCHMARK(BM_IntegrateVerlet)->Arg(64)->Arg(128)->Arg(256);
+BENCHMARK(BM_CollideSphere)->Arg(64)->Arg(128)->Arg(256);
+BENCHMARK(BM_VertexNormals)->Arg(64)->Arg(128)->Arg(256);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,331 @@
+#include "grid_solver.hpp"
+
+#include "clothsim/colliders.hpp"
+#include "verlet.hpp"
+
+#include <immintrin.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+namespace clothsim {
+namespace {
+
+constexpr int kPad = 2;  // zero columns each side of a stored spring row, so c - 2 and c + 1 are readable
+
+struct Direction {
+    int dr, dc;
+    SpringKind kind;
+};
+constexpr std::array<Direction, 6> kDirections = {{
+    {0, 1, SpringKind::Structural},
+    {1, 0, SpringKind::Structural},
+    {1, 1, SpringKind::Shear},
+    {1, -1, SpringKind::Shear},
+    {0, 2, SpringKind::Bending},
+    {2, 0, SpringKind::Bending},
+}};
+
+// Columns c whose spring (r, c) -> (r + dr, c + dc) lies inside the grid.
+int first_column(const Direction& d) { return std::max(0, -d.dc); }
+int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); }
+
+// The spring force factor s in F_a = s d: k (1 - L0 / |d|), computed with 1/|d| (no division by a length
+// that may be zero: a zero-length spring gets s = k, a coincident pair with L0 > 0 gets F = s * 0 = 0).
+//
+// Generic kernel: exact 1/sqrt, auto-vectorised for the baseline ISA.
+[[gnu::always_inline]] inline void spring_forces_generic(const float* __restrict x, const float* __restrict y,
+                                                       const float* __restrict z, const float* __restrict rest,
+                                                       int offset, int begin, int end, float k, float* __restrict fx,
+                                                       float* __restrict fy, float* __restrict fz) {
+    for (int i = begin; i < end; ++i) {
+        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        const float inv = r2 > 1e-30f ? 1.0f / std::sqrt(r2) : 0.0f;
+        const float s = k * (1.0f - rest[i] * inv);
+        fx[i - begin] = s * dx;
+        fy[i - begin] = s * dy;
+        fz[i - begin] = s * dz;
+    }
+}
+
+// AVX2 + FMA kernel: 1/sqrt from the hardware estimate plus one Newton step, y (1.5 - 0.5 r2 y^2), which
+// takes its 12-bit estimate to about 1e-7 relative: float accuracy at a fraction of sqrt + divide. The
+// scalar tail uses the same estimate and step, so every column of a row gets the same arithmetic.
+__attribute__((target("avx2,fma"))) void spring_forces_avx2(
+    const float* x, const float* y, const float* z, const float* rest, int offset, int begin, int end, float k,
+    float* fx, float* fy, float* fz) {
+    const __m256 vk = _mm256_set1_ps(k), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f),
+                 three_halves = _mm256_set1_ps(1.5f), tiny = _mm256_set1_ps(1e-30f);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + i + offset), _mm256_loadu_ps(x + i));
+        const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + i + offset), _mm256_loadu_ps(y + i));
+        const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + i + offset), _mm256_loadu_ps(z + i));
+        const __m256 r2 = _mm256_fmadd_ps(dx, dx, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dz, dz)));
+        const __m256 y0 = _mm256_rsqrt_ps(r2);
+        const __m256 y1 =
+            _mm256_mul_ps(y0, _mm256_fnmadd_ps(_mm256_mul_ps(half, r2), _mm256_mul_ps(y0, y0), three_halves));
+        const __m256 inv = _mm256_and_ps(y1, _mm256_cmp_ps(r2, tiny, _CMP_GT_OQ));
+        const __m256 s = _mm256_mul_ps(vk, _mm256_fnmadd_ps(_mm256_loadu_ps(rest + i), inv, one));
+        _mm256_storeu_ps(fx + (i - begin), _mm256_mul_ps(s, dx));
+        _mm256_storeu_ps(fy + (i - begin), _mm256_mul_ps(s, dy));
+        _mm256_storeu_ps(fz + (i - begin), _mm256_mul_ps(s, dz));
+    }
+    for (; i < end; ++i) {
+        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
+        const float r2 = std::fma(dx, dx, std::fma(dy, dy, dz * dz));
+        const float y0 = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(r2)));
+        const float y1 = y0 * std::fma(-(0.5f * r2), y0 * y0, 1.5f);
+        const float inv = r2 > 1e-30f ? y1 : 0.0f;
+        const float s = k * std::fma(-rest[i], inv, 1.0f);
+        fx[i - begin] = s * dx;
+        fy[i - begin] = s * dy;
+        fz[i - begin] = s * dz;
+    }
+}
+
+bool cpu_has_avx2_fma() {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+
+const bool kAvx2 = cpu_has_avx2_fma();
+
+}  // namespace
+
+const char* GridSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
+
+std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
+    if (t.rows < 1 || t.cols < 1) return std::nullopt;
+    GridSolver solver(t.rows, t.cols);
+    const std::size_t n = static_cast<std::size_t>(t.rows) * t.cols;
+    // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
+    // exactly one spring for the sweep to be the same model as the spring list.
+    for (auto& r : solver.rest_) r.assign(n, NAN);
+    for (const Spring& s : t.springs) {
+        if (s.a >= n || s.b >= n) return std::nullopt;
+        const int ra = static_cast<int>(s.a) / t.cols, ca = static_cast<int>(s.a) % t.cols;
+        const int rb = static_cast<int>(s.b) / t.cols, cb = static_cast<int>(s.b) % t.cols;
+        bool placed = false;
+        for (int d = 0; d < 6 && !placed; ++d) {
+            const Direction& dir = kDirections[d];
+            if (dir.kind != s.kind) continue;
+            // Either end may be listed first.
+            for (const auto& [r0, c0, r1, c1, start] : {std::tuple{ra, ca, rb, cb, s.a}, std::tuple{rb, cb, ra, ca, s.b}}) {
+                if (r1 - r0 == dir.dr && c1 - c0 == dir.dc) {
+                    if (!std::isnan(solver.rest_[d][start])) return std::nullopt;  // a duplicate spring
+                    solver.rest_[d][start] = s.rest_length;
+                    placed = true;
+                    break;
+                }
+            }
+        }
+        if (!placed) return std::nullopt;
+    }
+    for (int d = 0; d < 6; ++d) {
+        const Direction& dir = kDirections[d];
+        for (int r = 0; r < t.rows; ++r) {
+            for (int c = 0; c < t.cols; ++c) {
+                float& rest = solver.rest_[d][static_cast<std::size_t>(r) * t.cols + c];
+                const bool inside = r + dir.dr < t.rows && c >= first_column(dir) && c < end_column(dir, t.cols);
+                if (inside && std::isnan(rest)) return std::nullopt;  // the sweep would add a spring
+                if (!inside) rest = 0.0f;
+            }
+        }
+    }
+    return solver;
+}
+
+int GridSolver::effective_threads(int requested) const {
+    const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    const int wanted = requested > 0 ? requested : cores;
+    return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
+}
+
+void GridSolver::step(State& state, const SimulationSettings& settings, const Vec3Array* external, float h,
+                      int threads) {
+    const int blocks = effective_threads(threads);
+    const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
+    if (static_cast<int>(scratch_.size()) < blocks) scratch_.resize(blocks);
+    for (int b = 0; b < blocks; ++b) scratch_[b].window.resize(3 * row_floats);
+    zeros_.assign(row_floats, 0.0f);
+    boundary_slot_.assign(rows_, -1);
+    boundary_.resize(static_cast<std::size_t>(2 * blocks) * row_floats);
+    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
+    for (int b = 1; b < blocks; ++b) {
+        boundary_slot_[block_begin(b) - 2] = 2 * b;
+        boundary_slot_[block_begin(b) - 1] = 2 * b + 1;
+    }
+
+    if (blocks == 1) {
+        sweep(state, settings, external, h, 0, rows_, scratch_[0]);
+        return;
+    }
+#pragma omp parallel num_threads(blocks)
+    {
+        const int b = omp_get_thread_num();
+        // Phase 1: the two spring rows above the next block read that block's first rows, which its thread
+        // will overwrite; compute them while every position is still the old one.
+        if (b + 1 < blocks) {
+            const int next = block_begin(b + 1);
+            for (int r : {next - 2, next - 1}) {
+                spring_row(state, settings.springs, r,
+                           boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
+            }
+        }
+#pragma omp barrier
+        sweep(state, settings, external, h, block_begin(b), block_begin(b + 1), scratch_[b]);
+    }
+}
+
+// ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----
+
+namespace {
+
+struct Grid {
+    int rows, cols;
+    const std::array<std::vector<float>, 6>& rest;
+    std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
+    // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
+    std::size_t row_floats() const { return 18 * stride(); }
+};
+
+template <bool Avx2>
+[[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state,
+                                                   const SpringSettings& springs, int r, float* out) {
+    const std::size_t stride = grid.stride();
+    const float stiffness[3] = {springs.structural, springs.shear, springs.bending};
+    for (int d = 0; d < 6; ++d) {
+        const Direction& dir = kDirections[d];
+        float* f = out + 3 * d * stride + kPad;  // column 0 of component x
+        const int c0 = first_column(dir), c1 = end_column(dir, grid.cols);
+        // Columns without a spring, the padding and rows past the bottom hold zero.
+        const bool any = r + dir.dr < grid.rows && c1 > c0;
+        for (int comp = 0; comp < 3; ++comp) {
+            float* row = f + comp * stride;
+            if (!any) {
+                std::memset(row - kPad, 0, stride * sizeof(float));
+                continue;
+            }
+            for (int c = -kPad; c < c0; ++c) row[c] = 0.0f;
+            for (int c = c1; c < grid.cols + kPad; ++c) row[c] = 0.0f;
+        }
+        if (!any) continue;
+        const int row_start = r * grid.cols;
+        const int offset = dir.dr * grid.cols + dir.dc;
+        const float k = stiffness[static_cast<int>(dir.kind)];
+        if constexpr (Avx2) {
+            spring_forces_avx2(state.position.x.data(), state.position.y.data(), state.position.z.data(),
+                               grid.rest[d].data(), offset, row_start + c0, row_start + c1, k, f + c0,
+                               f + stride + c0, f + 2 * stride + c0);
+        } else {
+            spring_forces_generic(state.position.x.data(), state.position.y.data(), state.position.z.data(),
+                                  grid.rest[d].data(), offset, row_start + c0, row_start + c1, k, f + c0,
+                                  f + stride + c0, f + 2 * stride + c0);
+        }
+    }
+}
+
+// Row q's force, gathered from the spring rows q, q-1 and q-2 in one fixed order (+F on a spring's first
+// particle, -F on its second), then position Verlet for the row (gravity and damping inside). A particle
+// with inverse mass 0 is pinned and does not move. Every particle is read and written once.
+[[gnu::always_inline]] inline void integrate_row(const float* __restrict f0, const float* __restrict f1,
+                                                 const float* __restrict f2, const float* __restrict ext,
+                                                 float* __restrict x, float* __restrict m,
+                                                 const float* __restrict w, int cols, std::size_t stride,
+                                                 float g, float keep, float h2) {
+    // f0, f1, f2: component rows of spring rows q, q-1, q-2, each 6 directions apart by 3 * stride.
+    const std::size_t D = 3 * stride;
+    for (int c = 0; c < cols; ++c) {
+        float f = f0[c] + f0[D + c] + f0[2 * D + c] + f0[3 * D + c] + f0[4 * D + c] + f0[5 * D + c];
+        f -= f0[c - 1] + f0[4 * D + c - 2];                 // (0,+1) and (0,+2) springs ending here
+        f -= f1[D + c] + f1[2 * D + c - 1] + f1[3 * D + c + 1];  // (+1,0), (+1,+1), (+1,-1)
+        f -= f2[5 * D + c];                                  // (+2,0)
+        f += ext[c];
+        const float moved = m[c] * keep + (f * w[c] + g) * h2;
+        const float step = w[c] == 0.0f ? 0.0f : moved;  // a select, not a branch: the loop vectorises
+        m[c] = step;
+        x[c] += step;
+    }
+}
+
+template <bool Avx2>
+[[gnu::always_inline]] inline void sweep_body(const Grid& grid, const std::vector<float>& boundary,
+                                              const std::vector<int>& boundary_slot, State& state,
+                                              const SimulationSettings& settings, const Vec3Array* external, float h,
+                                              int begin, int end, float* window, const float* zeros) {
+    const std::size_t stride = grid.stride();
+    const std::size_t row_floats = grid.row_floats();
+    const auto [keep, h2] = verlet_coefficients(settings.springs.damping, h);
+    const glm::vec3 g = settings.forces.gravity;
+    // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
+    const float* spring_rows[3] = {zeros, zeros, zeros};
+    for (int r = std::max(begin - 2, 0); r < end; ++r) {
+        const float* current;
+        if (boundary_slot[r] >= 0) {
+            current = boundary.data() + static_cast<std::size_t>(boundary_slot[r]) * row_floats;
+        } else {
+            float* slot = window + static_cast<std::size_t>(r % 3) * row_floats;
+            spring_row_body<Avx2>(grid, state, settings.springs, r, slot);
+            current = slot;
+        }
+        spring_rows[2] = spring_rows[1];
+        spring_rows[1] = spring_rows[0];
+        spring_rows[0] = current;
+        if (r < begin) continue;
+        // Row r is complete: gather its forces, integrate it in place, collide it.
+        const std::size_t i0 = static_cast<std::size_t>(r) * grid.cols;
+        float* position[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
+        float* motion[3] = {state.motion.x.data() + i0, state.motion.y.data() + i0, state.motion.z.data() + i0};
+        const float* ext[3] = {zeros, zeros, zeros};  // no external force: add zeros, keep one loop
+        if (external) ext[0] = external->x.data() + i0, ext[1] = external->y.data() + i0, ext[2] = external->z.data() + i0;
+        const float gravity[3] = {g.x, g.y, g.z};
+        for (int comp = 0; comp < 3; ++comp) {
+            const std::size_t at = comp * stride + kPad;
+            integrate_row(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, ext[comp], position[comp],
+                          motion[comp], state.inverse_mass.data() + i0, grid.cols, stride, gravity[comp], keep, h2);
+        }
+        collide_all(state, settings.colliders, i0, i0 + grid.cols);
+    }
+}
+
+__attribute__((target("avx2,fma"))) void spring_row_avx2(const Grid& grid, const State& state,
+                                                          const SpringSettings& springs, int r, float* out) {
+    spring_row_body<true>(grid, state, springs, r, out);
+}
+void spring_row_generic(const Grid& grid, const State& state, const SpringSettings& springs, int r, float* out) {
+    spring_row_body<false>(grid, state, springs, r, out);
+}
+
+__attribute__((target("avx2,fma"))) void sweep_avx2(const Grid& grid, const std::vector<float>& boundary,
+                                                     const std::vector<int>& boundary_slot, State& state,
+                                                     const SimulationSettings& settings, const Vec3Array* external,
+                                                     float h, int begin, int end, float* window, const float* zeros) {
+    sweep_body<true>(grid, boundary, boundary_slot, state, settings, external, h, begin, end, window, zeros);
+}
+void sweep_generic(const Grid& grid, const std::vector<float>& boundary, const std::vector<int>& boundary_slot,
+                   State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int begin,
+                   int end, float* window, const float* zeros) {
+    sweep_body<false>(grid, boundary, boundary_slot, state, settings, external, h, begin, end, window, zeros);
+}
+
+}  // namespace
+
+void GridSolver::spring_row(const State& state, const SpringSettings& springs, int r, float* out) const {
+    const Grid grid{rows_, cols_, rest_};
+    kAvx2 ? spring_row_avx2(grid, state, springs, r, out) : spring_row_generic(grid, state, springs, r, out);
+}
+
+void GridSolver::sweep(State& state, const SimulationSettings& settings, const Vec3Array* external, float h,
+                       int begin, int end, Scratch& scratch) {
+    const Grid grid{rows_, cols_, rest_};
+    (kAvx2 ? sweep_avx2 : sweep_generic)(grid, boundary_, boundary_slot_, state, settings, external, h, begin, end,
+                                         scratch.window.data(), zeros_.data());
+    state.substep = h;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,60 @@
+// The fast solver for grid cloth.
+//
+// Design (see docs/PERFORMANCE.md for the figures):
+//  - Springs of a grid come in six directions: structural (0,+1) (+1,0), shear (+1,+1) (+1,-1), bending
+//    (0,+2) (+2,0). The springs of one direction starting in one row are a contiguous run of particles
+//    paired with a shifted run, so their forces are computed by one vector loop (AVX2 + FMA when the CPU
+//    has it, chosen at run time; plain C++ otherwise) and each spring is computed once.
+//  - One pass over the rows does everything a substep needs. Row q's force is complete once the spring
+//    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
+//    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it (position
+//    Verlet) and collides it in place right then. Every particle's data is read and written once.
+//  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
+//    two spring rows just above it; they are computed before a barrier into shared storage and both
+//    neighbouring threads use the stored values. Each particle's force is summed in the same order for
+//    any partition, so the result is bit-identical for any thread count.
+#pragma once
+
+#include "clothsim/settings.hpp"
+#include "clothsim/state.hpp"
+
+#include <array>
+#include <optional>
+#include <vector>
+
+namespace clothsim {
+
+class GridSolver {
+public:
+    // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions.
+    static std::optional<GridSolver> for_topology(const Topology& topology);
+
+    // One substep: springs + `external` forces (N per particle, or null), Verlet update, collisions.
+    void step(State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int threads);
+
+    // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
+    // at least 8.
+    int effective_threads(int requested) const;
+    // Which kernel runs on this CPU: "avx2+fma" or "generic".
+    static const char* kernel_name();
+
+private:
+    GridSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
+
+    struct Scratch {
+        std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
+    };
+    void sweep(State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int begin,
+               int end, Scratch& scratch);
+    // Forces of the springs starting in row r, into out[d][component][c] (6 x 3 x cols).
+    void spring_row(const State& state, const SpringSettings& springs, int r, float* out) const;
+
+    int rows_, cols_;
+    std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
+    std::vector<Scratch> scratch_;             // one per thread
+    std::vector<float> boundary_;              // spring rows just above block boundaries
+    std::vector<float> zeros_;                 // a spring row of zeros: the rows above row 0
+    std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
+};
+
+}  // namespace clothsim

@@ -33,59 +33,50 @@ constexpr std::array<Direction, 6> kDirections = {{
 int first_column(const Direction& d) { return std::max(0, -d.dc); }
 int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); }
 
-// The spring force factor s in F_a = s d: k (1 - L0 / |d|), computed with 1/|d| (no division by a length
-// that may be zero: a zero-length spring gets s = k, a coincident pair with L0 > 0 gets F = s * 0 = 0).
+// Spring forces of one run of springs, F_a = s d with s = k (|d| - L0) / |d| (s = k for L0 = 0; no force
+// when the ends of a spring with L0 > 0 coincide). The arithmetic is the textbook solver's, operation for
+// operation ((dx dx + dy dy) + dz dz, sqrt, (k (len - L0)) / len; no fused multiply-add), so the two
+// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt and divide are
+// correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
 //
-// Generic kernel: exact 1/sqrt, auto-vectorised for the baseline ISA.
+// Generic kernel: auto-vectorised for the baseline ISA.
 [[gnu::always_inline]] inline void spring_forces_generic(const float* __restrict x, const float* __restrict y,
                                                        const float* __restrict z, const float* __restrict rest,
                                                        int offset, int begin, int end, float k, float* __restrict fx,
                                                        float* __restrict fy, float* __restrict fz) {
     for (int i = begin; i < end; ++i) {
         const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
-        const float r2 = dx * dx + dy * dy + dz * dz;
-        const float inv = r2 > 1e-30f ? 1.0f / std::sqrt(r2) : 0.0f;
-        const float s = k * (1.0f - rest[i] * inv);
+        const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const float stretched = k * (length - rest[i]) / length;
+        const float s = rest[i] == 0.0f ? k : (length > 1e-12f ? stretched : 0.0f);
         fx[i - begin] = s * dx;
         fy[i - begin] = s * dy;
         fz[i - begin] = s * dz;
     }
 }
 
-// AVX2 + FMA kernel: 1/sqrt from the hardware estimate plus one Newton step, y (1.5 - 0.5 r2 y^2), which
-// takes its 12-bit estimate to about 1e-7 relative: float accuracy at a fraction of sqrt + divide. The
-// scalar tail uses the same estimate and step, so every column of a row gets the same arithmetic.
-__attribute__((target("avx2,fma"))) void spring_forces_avx2(
-    const float* x, const float* y, const float* z, const float* rest, int offset, int begin, int end, float k,
-    float* fx, float* fy, float* fz) {
-    const __m256 vk = _mm256_set1_ps(k), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f),
-                 three_halves = _mm256_set1_ps(1.5f), tiny = _mm256_set1_ps(1e-30f);
+// AVX2 kernel: the same operations eight springs at a time; the tail reuses the generic loop.
+__attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, const float* y, const float* z,
+                                                             const float* rest, int offset, int begin, int end,
+                                                             float k, float* fx, float* fy, float* fz) {
+    const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
     int i = begin;
     for (; i + 8 <= end; i += 8) {
         const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + i + offset), _mm256_loadu_ps(x + i));
         const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + i + offset), _mm256_loadu_ps(y + i));
         const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + i + offset), _mm256_loadu_ps(z + i));
-        const __m256 r2 = _mm256_fmadd_ps(dx, dx, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dz, dz)));
-        const __m256 y0 = _mm256_rsqrt_ps(r2);
-        const __m256 y1 =
-            _mm256_mul_ps(y0, _mm256_fnmadd_ps(_mm256_mul_ps(half, r2), _mm256_mul_ps(y0, y0), three_halves));
-        const __m256 inv = _mm256_and_ps(y1, _mm256_cmp_ps(r2, tiny, _CMP_GT_OQ));
-        const __m256 s = _mm256_mul_ps(vk, _mm256_fnmadd_ps(_mm256_loadu_ps(rest + i), inv, one));
+        const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                        _mm256_mul_ps(dz, dz));
+        const __m256 length = _mm256_sqrt_ps(r2);
+        const __m256 l0 = _mm256_loadu_ps(rest + i);
+        const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, _mm256_sub_ps(length, l0)), length);
+        const __m256 apart = _mm256_blendv_ps(zero, stretched, _mm256_cmp_ps(length, tiny, _CMP_GT_OQ));
+        const __m256 s = _mm256_blendv_ps(apart, vk, _mm256_cmp_ps(l0, zero, _CMP_EQ_OQ));
         _mm256_storeu_ps(fx + (i - begin), _mm256_mul_ps(s, dx));
         _mm256_storeu_ps(fy + (i - begin), _mm256_mul_ps(s, dy));
         _mm256_storeu_ps(fz + (i - begin), _mm256_mul_ps(s, dz));
     }
-    for (; i < end; ++i) {
-        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
-        const float r2 = std::fma(dx, dx, std::fma(dy, dy, dz * dz));
-        const float y0 = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(r2)));
-        const float y1 = y0 * std::fma(-(0.5f * r2), y0 * y0, 1.5f);
-        const float inv = r2 > 1e-30f ? y1 : 0.0f;
-        const float s = k * std::fma(-rest[i], inv, 1.0f);
-        fx[i - begin] = s * dx;
-        fy[i - begin] = s * dy;
-        fz[i - begin] = s * dz;
-    }
+    spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
 bool cpu_has_avx2_fma() {
@@ -93,11 +84,18 @@ bool cpu_has_avx2_fma() {
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
 
-const bool kAvx2 = cpu_has_avx2_fma();
+// Chosen once at start-up from the CPU; tests switch to the generic kernel to check it too.
+bool kAvx2 = cpu_has_avx2_fma();
 
 }  // namespace
 
 const char* GridSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
+
+bool GridSolver::force_generic_kernel(bool generic) {
+    const bool was_avx2 = kAvx2;
+    kAvx2 = !generic && cpu_has_avx2_fma();
+    return !was_avx2;
+}
 
 std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
     if (t.rows < 1 || t.cols < 1) return std::nullopt;
@@ -230,9 +228,11 @@ template <bool Avx2>
     }
 }
 
-// Row q's force, gathered from the spring rows q, q-1 and q-2 in one fixed order (+F on a spring's first
-// particle, -F on its second), then position Verlet for the row (gravity and damping inside). A particle
-// with inverse mass 0 is pinned and does not move. Every particle is read and written once.
+// Row q's force, gathered from the spring rows q, q-1 and q-2 (-F on a spring's second particle, +F on its
+// first), in the textbook solver's order: direction by direction, the spring ending at the particle before
+// the one starting there, external force last. Then position Verlet for the row (gravity and damping
+// inside). A particle with inverse mass 0 is pinned and does not move. Every particle is read and written
+// once.
 [[gnu::always_inline]] inline void integrate_row(const float* __restrict f0, const float* __restrict f1,
                                                  const float* __restrict f2, const float* __restrict ext,
                                                  float* __restrict x, float* __restrict m,
@@ -241,10 +241,13 @@ template <bool Avx2>
     // f0, f1, f2: component rows of spring rows q, q-1, q-2, each 6 directions apart by 3 * stride.
     const std::size_t D = 3 * stride;
     for (int c = 0; c < cols; ++c) {
-        float f = f0[c] + f0[D + c] + f0[2 * D + c] + f0[3 * D + c] + f0[4 * D + c] + f0[5 * D + c];
-        f -= f0[c - 1] + f0[4 * D + c - 2];                 // (0,+1) and (0,+2) springs ending here
-        f -= f1[D + c] + f1[2 * D + c - 1] + f1[3 * D + c + 1];  // (+1,0), (+1,+1), (+1,-1)
-        f -= f2[5 * D + c];                                  // (+2,0)
+        float f = 0.0f;
+        f = (f - f0[c - 1]) + f0[c];                      // (0,+1)
+        f = (f - f1[D + c]) + f0[D + c];                  // (+1,0)
+        f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];      // (+1,+1)
+        f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];      // (+1,-1)
+        f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];      // (0,+2)
+        f = (f - f2[5 * D + c]) + f0[5 * D + c];          // (+2,0)
         f += ext[c];
         const float moved = m[c] * keep + (f * w[c] + g) * h2;
         const float step = w[c] == 0.0f ? 0.0f : moved;  // a select, not a branch: the loop vectorises

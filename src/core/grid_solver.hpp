@@ -37,6 +37,9 @@ public:
     int effective_threads(int requested) const;
     // Which kernel runs on this CPU: "avx2+fma" or "generic".
     static const char* kernel_name();
+    // For tests: run the generic kernel even on an AVX2 CPU (true), or go back to the CPU's best (false).
+    // Returns whether the generic kernel was in use before. Not for use while a step runs.
+    static bool force_generic_kernel(bool generic);
 
 private:
     GridSolver(int rows, int cols) : rows_(rows), cols_(cols) {}

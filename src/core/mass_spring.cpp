@@ -89,7 +89,13 @@ bool MassSpring::wind_active() const {
 void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
     force.resize(state.size());
     accumulate_spring_forces(topology_, state.position, settings_.springs, force);
-    if (wind_active()) accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, force);
+    if (wind_active()) {
+        // Wind is summed on its own and added last, as the fast solver adds it, so both round alike.
+        Vec3Array wind;
+        wind.resize(state.size());
+        accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, wind);
+        for (std::size_t i = 0; i < state.size(); ++i) force.add(i, wind.get(i));
+    }
 }
 
 void MassSpring::run_steps(long long steps) {

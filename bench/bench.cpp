@@ -2,6 +2,8 @@
 //
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
+#include "textbook_aos.hpp"
+
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
 
@@ -52,11 +54,12 @@ double median_seconds(Work&& work, int repeats, double min_seconds) {
     return samples[samples.size() / 2];
 }
 
-// Bytes of per-particle simulation state the step touches: position and motion (6 floats), inverse mass,
-// mass and the pin flag, plus the fast solver's six rest lengths.
-double state_bytes_per_particle(SolverMethod method) {
+// Bytes of per-particle simulation state: position and motion (6 floats), mass, inverse mass and the pin
+// flag, plus the fast solver's six rest lengths; the array-of-structs particle as laid out in memory.
+double state_bytes_per_particle(const std::string& method) {
+    if (method == "textbook-aos") return sizeof(bench::TextbookAos::Particle);
     const double common = 6 * 4 + 4 + 4 + 1;
-    return method == SolverMethod::Fast ? common + 6 * 4 : common;
+    return method == "fast" ? common + 6 * 4 : common;
 }
 
 struct Row {
@@ -65,7 +68,8 @@ struct Row {
     std::string method;
     int threads = 1;
     double seconds_per_step = 0;
-    double speedup = 0;
+    double speedup = 0;      // against the textbook solver in MassSpring (SoA, spring list)
+    double speedup_aos = 0;  // against the array-of-structs textbook of the performance notes
 };
 
 }  // namespace
@@ -95,17 +99,22 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     try {
         for (int size : sizes) {
-            double textbook = 0;
+            double textbook = 0, aos = 0;
             {
                 MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Textbook, 1));
+                bench::TextbookAos plain(sim);
+                aos = median_seconds([&] { plain.step(); }, repeats, min_seconds);
                 textbook = median_seconds([&] { sim.step(); }, repeats, min_seconds);
-                rows.push_back({size, sim.particle_count(), sim.spring_count(), "textbook", 1, textbook, 1.0});
+                rows.push_back({size, sim.particle_count(), sim.spring_count(), "textbook-aos", 1, aos,
+                                textbook / aos, 1.0});
+                rows.push_back({size, sim.particle_count(), sim.spring_count(), "textbook", 1, textbook, 1.0,
+                                aos / textbook});
             }
             for (int t : thread_counts) {
                 MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Fast, t));
                 const double fast = median_seconds([&] { sim.step(); }, repeats, min_seconds);
                 rows.push_back({size, sim.particle_count(), sim.spring_count(), "fast", sim.solver_threads(), fast,
-                                textbook / fast});
+                                textbook / fast, aos / fast});
             }
         }
     } catch (const SceneError& e) {
@@ -135,14 +144,13 @@ int main(int argc, char** argv) {
         budgets.push_back({size, 1e3 * substep, 1e3 * prep, left > 0 ? static_cast<long long>(left / substep) : 0});
     }
 
-    std::printf("%6s %9s %9s %9s %7s %12s %12s %12s %10s %8s\n", "size", "particles", "springs", "method", "threads",
-                "ns/particle", "ns/spring", "steps/s", "B/particle", "speedup");
+    std::printf("%6s %9s %9s %12s %7s %12s %12s %12s %10s %9s %9s\n", "size", "particles", "springs", "method",
+                "threads", "ns/particle", "ns/spring", "steps/s", "B/particle", "vs soa", "vs aos");
     for (const Row& r : rows) {
-        const SolverMethod m = r.method == "fast" ? SolverMethod::Fast : SolverMethod::Textbook;
-        std::printf("%6d %9zu %9zu %9s %7d %12.3f %12.4f %12.0f %10.0f %8.2f\n", r.size, r.particles, r.springs,
-                    r.method.c_str(), r.threads, 1e9 * r.seconds_per_step / r.particles,
-                    1e9 * r.seconds_per_step / r.springs, 1.0 / r.seconds_per_step, state_bytes_per_particle(m),
-                    r.speedup);
+        std::printf("%6d %9zu %9zu %12s %7d %12.3f %12.4f %12.0f %10.0f %9.2f %9.2f\n", r.size, r.particles,
+                    r.springs, r.method.c_str(), r.threads, 1e9 * r.seconds_per_step / r.particles,
+                    1e9 * r.seconds_per_step / r.springs, 1.0 / r.seconds_per_step, state_bytes_per_particle(r.method),
+                    r.speedup, r.speedup_aos);
     }
     std::printf("\nfast solver kernel: %s\n", MassSpring::fast_kernel_name());
     std::printf("frame budget %.1f ms (fast solver, %d threads):\n", budget_ms,
@@ -160,7 +168,8 @@ int main(int argc, char** argv) {
                                  {"ns_per_particle_step", 1e9 * r.seconds_per_step / r.particles},
                                  {"ns_per_spring_step", 1e9 * r.seconds_per_step / r.springs},
                                  {"steps_per_second", 1.0 / r.seconds_per_step},
-                                 {"speedup_vs_textbook", r.speedup}});
+                                 {"state_bytes_per_particle", state_bytes_per_particle(r.method)},
+                                 {"speedup_vs_textbook", r.speedup}, {"speedup_vs_textbook_aos", r.speedup_aos}});
         }
         for (const Budget& b : budgets) {
             j["frame_budget"].push_back({{"size", b.size}, {"budget_ms", budget_ms}, {"substep_ms", b.substep_ms},
@@ -176,12 +185,12 @@ int main(int argc, char** argv) {
     if (!csv_path.empty()) {
         std::ofstream out(csv_path);
         out << "size,particles,springs,method,threads,ns_per_particle_step,ns_per_spring_step,steps_per_second,"
-               "state_bytes_per_particle,speedup_vs_textbook\n";
+               "state_bytes_per_particle,speedup_vs_textbook,speedup_vs_textbook_aos\n";
         for (const Row& r : rows) {
-            const SolverMethod m = r.method == "fast" ? SolverMethod::Fast : SolverMethod::Textbook;
             out << r.size << ',' << r.particles << ',' << r.springs << ',' << r.method << ',' << r.threads << ','
                 << 1e9 * r.seconds_per_step / r.particles << ',' << 1e9 * r.seconds_per_step / r.springs << ','
-                << 1.0 / r.seconds_per_step << ',' << state_bytes_per_particle(m) << ',' << r.speedup << '\n';
+                << 1.0 / r.seconds_per_step << ',' << state_bytes_per_particle(r.method) << ',' << r.speedup << ','
+                << r.speedup_aos << '\n';
         }
         if (!out) {
             std::cerr << "clothsim-bench: error: cannot write " << csv_path << "\n";

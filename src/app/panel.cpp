@@ -349,6 +349,13 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
                     app.stats.render_ms);
         ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                     app.sim.time());
+        const bool fast = app.sim.fast_solver_available() && app.scene.settings.solver.method == SolverMethod::Fast;
+        const double per_substep_us = app.stats.substeps_last_frame > 0
+                                          ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
+                                          : 0.0;
+        ImGui::Text("solver: %s (%s, %d thread%s), %.1f us per substep", fast ? "fast" : "textbook",
+                    fast ? MassSpring::fast_kernel_name() : "spring list", app.sim.solver_threads(),
+                    app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
         if (app.stats.dropped_seconds > 0.0) {
             ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
                                app.stats.dropped_seconds);

@@ -148,17 +148,21 @@ void GridSolver::step(State& state, const SimulationSettings& settings, const Ve
                       int threads) {
     const int blocks = effective_threads(threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
-    if (static_cast<int>(scratch_.size()) < blocks) scratch_.resize(blocks);
-    for (int b = 0; b < blocks; ++b) scratch_[b].window.resize(3 * row_floats);
-    zeros_.assign(row_floats, 0.0f);
-    boundary_slot_.assign(rows_, -1);
-    boundary_.resize(static_cast<std::size_t>(2 * blocks) * row_floats);
-    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
-    for (int b = 1; b < blocks; ++b) {
-        boundary_slot_[block_begin(b) - 2] = 2 * b;
-        boundary_slot_[block_begin(b) - 1] = 2 * b + 1;
+    // Buffers and the block layout are set up again only when the block count changes.
+    if (blocks != blocks_) {
+        blocks_ = blocks;
+        scratch_.resize(blocks);
+        for (Scratch& s : scratch_) s.window.assign(3 * row_floats, 0.0f);
+        zeros_.assign(row_floats, 0.0f);
+        boundary_slot_.assign(rows_, -1);
+        boundary_.assign(static_cast<std::size_t>(2 * blocks) * row_floats, 0.0f);
+        for (int b = 1; b < blocks; ++b) {
+            const int begin = static_cast<int>(static_cast<long long>(rows_) * b / blocks);
+            boundary_slot_[begin - 2] = 2 * b;
+            boundary_slot_[begin - 1] = 2 * b + 1;
+        }
     }
-
+    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
     if (blocks == 1) {
         sweep(state, settings, external, h, 0, rows_, scratch_[0]);
         return;

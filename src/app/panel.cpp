@@ -63,6 +63,23 @@ void copy_field(const FieldInfo& f, const Scene& from, Scene& to) {
                f.ref(to));
 }
 
+// A combo box over an enumeration's names (as written in scene files); true when the user picked one.
+template <class Enum>
+bool enum_combo(const char* label, Enum* value, std::span<const std::string_view> names) {
+    const int current = static_cast<int>(*value);
+    bool edited = false;
+    if (ImGui::BeginCombo(label, std::string(names[current]).c_str())) {
+        for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+            if (ImGui::Selectable(std::string(names[i]).c_str(), i == current)) {
+                *value = static_cast<Enum>(i);
+                edited = true;
+            }
+        }
+        ImGui::EndCombo();
+    }
+    return edited;
+}
+
 // The label shown for a field: its last name component ("structural" for springs.structural).
 std::string label_of(const FieldInfo& f) {
     const auto dot = f.name.rfind('.');
@@ -127,36 +144,8 @@ bool field_widget(AppState& app, const FieldInfo& f) {
                 }
                 return edited;
             },
-            [&](SolverMethod* v) {
-                int method = static_cast<int>(*v);
-                const auto names = solver_method_names();
-                bool edited = false;
-                if (ImGui::BeginCombo(label.c_str(), std::string(names[method]).c_str())) {
-                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
-                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == method)) {
-                            *v = static_cast<SolverMethod>(i);
-                            edited = true;
-                        }
-                    }
-                    ImGui::EndCombo();
-                }
-                return edited;
-            },
-            [&](WindModel* v) {
-                int model = static_cast<int>(*v);
-                const auto names = wind_model_names();
-                bool edited = false;
-                if (ImGui::BeginCombo(label.c_str(), std::string(names[model]).c_str())) {
-                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
-                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == model)) {
-                            *v = static_cast<WindModel>(i);
-                            edited = true;
-                        }
-                    }
-                    ImGui::EndCombo();
-                }
-                return edited;
-            },
+            [&](SolverMethod* v) { return enum_combo(label.c_str(), v, solver_method_names()); },
+            [&](WindModel* v) { return enum_combo(label.c_str(), v, wind_model_names()); },
         },
         f.ref(app.scene));
     tooltip(f);

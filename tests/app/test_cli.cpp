@@ -2,6 +2,8 @@
 // --json report, the trajectory CSV and the OBJ mesh.
 #include "clothsim/scene.hpp"
 
+#include "run_process.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -25,73 +27,13 @@ namespace {
 
 const fs::path kData = CLOTHSIM_TEST_DATA;
 
-struct RunResult {
-    int code = -1;
-    std::string out;  // stdout
-    std::string err;  // stderr
-};
+using clothsim::test::read_file;
+using clothsim::test::RunResult;
+using clothsim::test::TempDir;
 
-std::string quote(const std::string& arg) {
-    std::string q = "'";
-    for (char c : arg) {
-        if (c == '\'') q += "'\\''";
-        else q += c;
-    }
-    return q + "'";
-}
-
-std::string read_file(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// A fresh directory for one test's files, removed when the test ends.
-class TempDir {
-public:
-    explicit TempDir(const std::string& name)
-        : path_(fs::temp_directory_path() / ("clothsim_test_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    const fs::path& path() const { return path_; }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-
-private:
-    fs::path path_;
-};
-
-// Runs the clothsim executable with `args`; stdout is captured through the pipe, stderr through a file.
-// `prefix` goes before the command (e.g. "env -u DISPLAY" to run without a display).
+// Runs clothsim with `args`; `prefix` goes before the command (e.g. "env -u DISPLAY").
 RunResult run_clothsim(const std::vector<std::string>& args, const std::string& prefix = "") {
-    static int counter = 0;
-    const fs::path err_file =
-        fs::temp_directory_path() /
-        ("clothsim_test_" + std::to_string(::getpid()) + "_stderr_" + std::to_string(counter++) + ".txt");
-    std::string command = prefix;
-    command.append(prefix.empty() ? "" : " ").append(quote(CLOTHSIM_EXE));
-    // Appends, not "literal" + string: GCC 12 warns falsely on that (-Wrestrict, GCC bug 105329).
-    for (const std::string& a : args) command.append(" ").append(quote(a));
-    command.append(" 2>").append(quote(err_file.string()));
-
-    RunResult result;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    REQUIRE(pipe != nullptr);
-    char buffer[4096];
-    std::size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.out.append(buffer, n);
-    const int status = ::pclose(pipe);
-    REQUIRE(WIFEXITED(status));
-    result.code = WEXITSTATUS(status);
-    result.err = read_file(err_file);
-    std::error_code ec;
-    fs::remove(err_file, ec);
-    return result;
+    return clothsim::test::run_process(CLOTHSIM_EXE, args, prefix);
 }
 
 std::vector<std::string> lines_of(const std::string& text) {
@@ -121,8 +63,6 @@ bool is_finite_number(const std::string& text) {
     return used == text.size() && std::isfinite(v);
 }
 
-// A failed run shows what the program said.
-#define CAPTURE_RUN(r) INFO("exit code " << (r).code << "\nstdout:\n" << (r).out << "\nstderr:\n" << (r).err)
 
 // Runs expecting exit code 2 (bad input) and a message on stderr with every one of `needles`.
 void expect_bad_input(const std::vector<std::string>& args, std::initializer_list<std::string> needles,

@@ -14,6 +14,8 @@
 #include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
 
+#include "run_process.hpp"
+
 #include <catch2/catch.hpp>
 #include <stb_image.h>
 
@@ -48,76 +50,18 @@ const std::string kSize = "1280x720";
 // Frames of the scripted runs that look at the simulated cloth: one step of integration.dt each (1 s at 60 Hz).
 constexpr int kFrames = 60;
 
-struct RunResult {
-    int code = -1;
-    std::string out;  // stdout
-    std::string err;  // stderr
-};
+using clothsim::test::RunResult;
+using clothsim::test::TempDir;
 
-#define CAPTURE_RUN(r) INFO("exit code " << (r).code << "\nstdout:\n" << (r).out << "\nstderr:\n" << (r).err)
 
-std::string quote(const std::string& arg) {
-    std::string q = "'";
-    for (char c : arg) {
-        if (c == '\'') q += "'\\''";
-        else q += c;
-    }
-    return q + "'";
-}
-
-std::string read_text(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// A fresh directory for one test's files, removed when the test ends.
-class TempDir {
-public:
-    explicit TempDir(const std::string& name)
-        : path_(fs::temp_directory_path() / ("clothsim_render_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    const fs::path& path() const { return path_; }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-
-private:
-    fs::path path_;
-};
-
-// Runs the clothsim executable with `args` (stdout through the pipe, stderr through a file in `dir`).
-// `env` holds NAME=value assignments put before the command with env(1).
-RunResult run_clothsim(const TempDir& dir, const std::vector<std::string>& args,
-                       const std::vector<std::string>& env = {}) {
-    static int counter = 0;
-    const fs::path err_file = dir / ("stderr_" + std::to_string(counter++) + ".txt");
-    std::string command;
+// Runs clothsim with `args`; `env` holds NAME=value assignments put before the command with env(1).
+RunResult run_clothsim(const TempDir&, const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+    std::string prefix;
     if (!env.empty()) {
-        command = "env";
-        for (const std::string& e : env) command.append(" ").append(quote(e));
-        command.append(" ");
+        prefix = "env";
+        for (const std::string& e : env) prefix.append(" ").append(clothsim::test::quote(e));
     }
-    command.append(quote(CLOTHSIM_EXE));
-    for (const std::string& a : args) command.append(" ").append(quote(a));
-    command.append(" 2>").append(quote(err_file.string()));
-
-    RunResult result;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    REQUIRE(pipe != nullptr);
-    char buffer[4096];
-    std::size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.out.append(buffer, n);
-    const int status = ::pclose(pipe);
-    REQUIRE(WIFEXITED(status));
-    result.code = WEXITSTATUS(status);
-    result.err = read_text(err_file);
-    return result;
+    return clothsim::test::run_process(CLOTHSIM_EXE, args, prefix);
 }
 
 struct Rgb {
@@ -527,7 +471,7 @@ TEST_CASE("render error: a shader that does not compile names its file and line,
     // Break one line of lit.frag (a statement inside main) and remember its number.
     std::vector<std::string> lines;
     {
-        std::istringstream in(read_text(shaders / "lit.frag"));
+        std::istringstream in(clothsim::test::read_file(shaders / "lit.frag"));
         for (std::string line; std::getline(in, line);) lines.push_back(line);
     }
     int broken = 0;

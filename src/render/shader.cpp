@@ -4,7 +4,7 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <regex>
+#include <cctype>
 #include <sstream>
 #include <vector>
 
@@ -51,10 +51,39 @@ GLuint compile(GLenum stage, const std::filesystem::path& path) {
 }  // namespace
 
 std::string annotate_log(const std::string& log, const std::string& file) {
-    static const std::regex mesa(R"(\b0:(\d+)\((\d+)\))");  // Mesa: 0:12(5): error: ...
-    static const std::regex nvidia(R"(\b0\((\d+)\))");      // NVIDIA: 0(12) : error ...
-    std::string out = std::regex_replace(log, mesa, file + ":$1:$2");
-    return std::regex_replace(out, nvidia, file + ":$1");
+    // Mesa writes "0:LINE(COL): error", NVIDIA "0(LINE) : error": source string 0 is our file.
+    std::string out;
+    std::size_t i = 0;
+    auto digits = [&](std::size_t from) {
+        std::size_t end = from;
+        while (end < log.size() && std::isdigit(static_cast<unsigned char>(log[end]))) ++end;
+        return end;
+    };
+    while (i < log.size()) {
+        const bool at_start = i == 0 || !std::isalnum(static_cast<unsigned char>(log[i - 1]));
+        if (at_start && log.compare(i, 2, "0:") == 0) {  // Mesa
+            const std::size_t line_end = digits(i + 2);
+            if (line_end > i + 2 && line_end < log.size() && log[line_end] == '(') {
+                const std::size_t col_end = digits(line_end + 1);
+                if (col_end > line_end + 1 && col_end < log.size() && log[col_end] == ')') {
+                    out += file + ":" + log.substr(i + 2, line_end - i - 2) + ":" +
+                           log.substr(line_end + 1, col_end - line_end - 1);
+                    i = col_end + 1;
+                    continue;
+                }
+            }
+        }
+        if (at_start && log.compare(i, 2, "0(") == 0) {  // NVIDIA
+            const std::size_t line_end = digits(i + 2);
+            if (line_end > i + 2 && line_end < log.size() && log[line_end] == ')') {
+                out += file + ":" + log.substr(i + 2, line_end - i - 2);
+                i = line_end + 1;
+                continue;
+            }
+        }
+        out += log[i++];
+    }
+    return out;
 }
 
 std::filesystem::path shader_directory() {

@@ -73,6 +73,8 @@ public:
     // and with how many threads.
     bool fast_solver_available() const { return grid_ != nullptr; }
     int solver_threads() const;
+    // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
+    int last_solver_iterations() const { return last_iterations_; }
     // The fast solver's spring kernel on this CPU: "avx2+fma" or "generic" (chosen at run time).
     static const char* fast_kernel_name();
 
@@ -90,6 +92,7 @@ private:
     void restart(const std::vector<glm::vec3>& velocity, float h);
     void compute_forces(const State& state, Vec3Array& force) const;
     bool wind_active() const;
+    void step_velocity_integrator(Integrator integrator, float h);
 
     Topology topology_;
     State state_;
@@ -98,6 +101,7 @@ private:
     Vec3Array force_;        // N, scratch of the current substep
     float rest_area_ = 0.0f; // m^2: sum of the triangles' rest areas
     double carry_ = 0.0;     // s: time advance() has not yet stepped
+    int last_iterations_ = 0;
 };
 
 // The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it

@@ -28,8 +28,8 @@ public:
 };
 
 // ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
-using FieldRef =
-    std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*, SolverMethod*>;
+using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*,
+                              SolverMethod*, Integrator*>;
 
 struct FieldInfo {
     std::string_view name;  // dotted name, as in the scene file and --set
@@ -51,6 +51,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field);
 std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
 std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook
+std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd
 
 // ---- Loading and overriding. All throw SceneError; on a throw the target scene is left unchanged. ----
 Scene parse_scene(std::string_view toml_text, std::string_view source_name);

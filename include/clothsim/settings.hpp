@@ -17,6 +17,15 @@ namespace clothsim {
 // Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
 
+// The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd).
+enum class Integrator {
+    Verlet,           // position Verlet with physical damping: second order, symplectic (the default)
+    SymplecticEuler,  // semi-implicit Euler: v += h a, x += h v; first order, symplectic
+    Rk4,              // classical Runge-Kutta: fourth order, explicit
+    ImplicitEuler,    // backward Euler linearised once per step, CG on the spring Jacobian (Baraff-Witkin 1998)
+    Xpbd,             // extended position-based dynamics, one iteration per substep, compliance 1/k
+};
+
 // Which implementation advances the cloth. Both integrate the same model; see src/core/grid_solver.hpp.
 enum class SolverMethod {
     Fast,      // row sweeps over the grid: vectorised, multi-threaded, each spring once, stages fused
@@ -93,6 +102,8 @@ struct ColliderSettings {
 struct IntegrationSettings {
     float dt = 1.0f / 60.0f;  // s: one step (one frame of the app)
     int substeps = 25;        // integration substeps per step; each advances dt / substeps
+    Integrator integrator = Integrator::Verlet;
+    float tolerance = 1e-5f;  // implicit Euler: CG stops at this residual relative to the right-hand side
 };
 
 struct SolverSettings {

@@ -62,6 +62,9 @@ struct State {
     std::vector<std::uint8_t> pinned;
     double time = 0.0;            // s
     float substep = 0.0f;         // s: the substep `motion` belongs to
+    // Which integrator's convention `motion` follows: Verlet keeps x - x_prev; every other integrator keeps
+    // v h, its velocity times the substep (the same displacement a substep at that velocity makes).
+    int integrator = 0;
 
     std::size_t size() const { return position.size(); }
 };

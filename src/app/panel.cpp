@@ -32,6 +32,7 @@ constexpr SliderHint kHints[] = {
     {"springs.bending", 0.0f, 1e5f, true},    {"springs.damping", 0.0f, 100.0f, true},
     {"forces.drag", 0.0f, 10.0f, true},       {"cloth.mass", 0.001f, 100.0f, true},
     {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
+    {"integration.tolerance", 1e-10f, 1e-2f, true},
 };
 
 const SliderHint* hint_for(std::string_view name) {
@@ -146,6 +147,7 @@ bool field_widget(AppState& app, const FieldInfo& f) {
             },
             [&](SolverMethod* v) { return enum_combo(label.c_str(), v, solver_method_names()); },
             [&](WindModel* v) { return enum_combo(label.c_str(), v, wind_model_names()); },
+            [&](Integrator* v) { return enum_combo(label.c_str(), v, integrator_names()); },
         },
         f.ref(app.scene));
     tooltip(f);

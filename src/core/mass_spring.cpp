@@ -3,6 +3,7 @@
 #include "clothsim/colliders.hpp"
 #include "forces.hpp"
 #include "grid_solver.hpp"
+#include "integrators.hpp"
 #include "verlet.hpp"
 
 #include <glm/common.hpp>
@@ -43,7 +44,8 @@ MassSpring::MassSpring(const MassSpring& other)
       grid_(other.grid_ ? std::make_unique<GridSolver>(*other.grid_) : nullptr),
       force_(other.force_),
       rest_area_(other.rest_area_),
-      carry_(other.carry_) {}
+      carry_(other.carry_),
+      last_iterations_(other.last_iterations_) {}
 MassSpring& MassSpring::operator=(const MassSpring& other) {
     if (this != &other) *this = MassSpring(other);
     return *this;
@@ -64,9 +66,13 @@ float MassSpring::substep_length() const {
 // inside), collisions. The fast solver runs the same stages fused row by row (grid_solver.hpp says why).
 void MassSpring::step() {
     const float h = substep_length();
-    if (h != state_.substep) restart(velocities(), h);
+    const Integrator integrator = settings_.integration.integrator;
+    if (h != state_.substep || static_cast<int>(integrator) != state_.integrator) restart(velocities(), h);
 
-    if (grid_ && settings_.solver.method == SolverMethod::Fast) {
+    if (integrator != Integrator::Verlet) {
+        step_velocity_integrator(integrator, h);
+        collide_all(state_, settings_.colliders);
+    } else if (grid_ && settings_.solver.method == SolverMethod::Fast) {
         const Vec3Array* external = nullptr;
         if (wind_active()) {
             force_.resize(state_.size());
@@ -80,6 +86,26 @@ void MassSpring::step() {
         collide_all(state_, settings_.colliders);
     }
     state_.time += h;
+}
+
+// One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.
+void MassSpring::step_velocity_integrator(Integrator integrator, float h) {
+    const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
+    const ForceFunction external = [this](const State& s, Vec3Array& f) {
+        f.resize(s.size());
+        if (wind_active()) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
+    };
+    const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
+    switch (integrator) {
+        case Integrator::SymplecticEuler: step_symplectic_euler(state_, dynamics, h); break;
+        case Integrator::Rk4: step_rk4(state_, dynamics, h); break;
+        case Integrator::ImplicitEuler:
+            last_iterations_ = step_implicit_euler(state_, dynamics, topology_, settings_.springs,
+                                                   settings_.integration.tolerance, h);
+            break;
+        case Integrator::Xpbd: step_xpbd(state_, dynamics, topology_, settings_.springs, h); break;
+        case Integrator::Verlet: break;  // handled by step()
+    }
 }
 
 bool MassSpring::wind_active() const {
@@ -115,8 +141,18 @@ long long MassSpring::advance(double seconds) {
 }
 
 void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
-    compute_forces(state_, force_);
-    start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
+    const Integrator integrator = settings_.integration.integrator;
+    state_.integrator = static_cast<int>(integrator);
+    if (integrator == Integrator::Verlet) {
+        compute_forces(state_, force_);
+        start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
+        return;
+    }
+    // The velocity integrators keep motion = v h.
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        state_.motion.set(i, state_.pinned[i] ? glm::vec3(0.0f) : velocity[i] * h);
+    }
+    state_.substep = h;
 }
 
 Particle MassSpring::particle(std::size_t i) const {
@@ -131,6 +167,13 @@ std::vector<glm::vec3> MassSpring::positions() const {
 }
 
 std::vector<glm::vec3> MassSpring::velocities() const {
+    if (state_.integrator != static_cast<int>(Integrator::Verlet)) {
+        std::vector<glm::vec3> v(state_.size(), glm::vec3(0.0f));
+        if (state_.substep > 0.0f) {
+            for (std::size_t i = 0; i < v.size(); ++i) v[i] = state_.motion.get(i) / state_.substep;
+        }
+        return v;
+    }
     Vec3Array force;
     compute_forces(state_, force);
     return verlet_velocities(state_, force, settings_.forces.gravity, settings_.springs.damping);

@@ -58,6 +58,8 @@ const std::array kFields = {
 
     FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
     FieldInfo{"integration.substeps", "", 1, 10000, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
+    FieldInfo{"integration.integrator", "", 0, 0, "time integrator (orders: verlet 2, symplectic-euler 1, rk4 4, implicit-euler 1; xpbd tends to the spring model as substeps grow)", [](Scene& s) -> FieldRef { return &s.settings.integration.integrator; }},
+    FieldInfo{"integration.tolerance", "", 1e-12, 0.1, "implicit-euler: conjugate-gradient residual relative to the right-hand side", [](Scene& s) -> FieldRef { return &s.settings.integration.tolerance; }},
 
     FieldInfo{"solver.method", "", 0, 0, "fast: vectorised multi-threaded row sweeps; textbook: spring-list loop (the test oracle)", [](Scene& s) -> FieldRef { return &s.settings.solver.method; }},
     FieldInfo{"solver.threads", "", 0, 64, "threads of the fast solver; 0 = one per core; results are identical for any count", [](Scene& s) -> FieldRef { return &s.settings.solver.threads; }},
@@ -68,6 +70,8 @@ constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corner
                                                              "left-edge"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
+constexpr std::array<std::string_view, 5> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
+                                                               "xpbd"};
 
 // Shortest text that reads back to the same float (std::to_chars), so 0.2f prints as 0.2, not 0.200000003.
 std::string number(double v) {
@@ -108,6 +112,7 @@ const FieldInfo* find_field(std::string_view name) {
 std::span<const std::string_view> pin_preset_names() { return kPinPresetNames; }
 std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
 std::span<const std::string_view> solver_method_names() { return kSolverMethodNames; }
+std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
 
 std::string describe_allowed(const FieldInfo& field) {
     Scene scratch;
@@ -128,6 +133,7 @@ std::string describe_allowed(const FieldInfo& field) {
             [&](PinSpec*) { return "one of " + join(kPinPresetNames) + ", a list of [row, col], or a table with preset and particles"; },
             [&](WindModel*) { return "one of " + join(kWindModelNames); },
             [&](SolverMethod*) { return "one of " + join(kSolverMethodNames); },
+            [&](Integrator*) { return "one of " + join(kIntegratorNames); },
         },
         field.ref(scratch));
 }
@@ -172,6 +178,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
             },
             [&](WindModel* v) { return quoted(kWindModelNames[static_cast<int>(*v)]); },
             [&](SolverMethod* v) { return quoted(kSolverMethodNames[static_cast<int>(*v)]); },
+            [&](Integrator* v) { return quoted(kIntegratorNames[static_cast<int>(*v)]); },
         },
         field.ref(s));
 }

@@ -172,6 +172,12 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
                 *target = *v;
                 return true;
             },
+            [&](Integrator* target) {
+                const auto v = enum_of<Integrator>(node, integrator_names());
+                if (!v) return false;
+                *target = *v;
+                return true;
+            },
         },
         field.ref(scene));
 }

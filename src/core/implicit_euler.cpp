@@ -1,0 +1,117 @@
+#include "integrators.hpp"
+
+#include "forces.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+namespace clothsim {
+namespace {
+
+// out = K u for the spring Jacobian K = dF/dx at `position`. Per spring, with n = d/|d| and
+// alpha = max(0, 1 - L0/|d|): Ks = k (n n^T + alpha (I - n n^T)); K adds Ks (u_b - u_a) on a, minus on b.
+// Clamping alpha at 0 drops the destabilising transverse term of compressed springs (Baraff & Witkin
+// 1998, section 5.2; Choi & Ko 2002), keeping -K positive semi-definite.
+void spring_jacobian_times(const Topology& topology, const Vec3Array& position, const SpringSettings& springs,
+                           const Vec3Array& u, Vec3Array& out) {
+    out.resize(u.size());
+    for (const Spring& s : topology.springs) {
+        const float k = stiffness_of(springs, s.kind);
+        if (k == 0.0f) continue;
+        const glm::vec3 d = position.get(s.b) - position.get(s.a);
+        const float length = glm::length(d);
+        const glm::vec3 du = u.get(s.b) - u.get(s.a);
+        glm::vec3 f;
+        if (s.rest_length == 0.0f) {
+            f = k * du;  // F = k d exactly: K = k I
+        } else {
+            if (!(length > 1e-12f)) continue;
+            const glm::vec3 n = d / length;
+            const float alpha = std::max(0.0f, 1.0f - s.rest_length / length);
+            const glm::vec3 along = glm::dot(n, du) * n;
+            f = k * (along + alpha * (du - along));
+        }
+        out.add(s.a, f);
+        out.add(s.b, -f);
+    }
+}
+
+double dot(const Vec3Array& a, const Vec3Array& b) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        sum += double(a.x[i]) * b.x[i] + double(a.y[i]) * b.y[i] + double(a.z[i]) * b.z[i];
+    }
+    return sum;
+}
+
+}  // namespace
+
+int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
+                        const SpringSettings& springs, float tolerance, float h) {
+    const std::size_t n = state.size();
+    const float c = dynamics.damping;
+    state.substep = h;
+    Vec3Array force, v, kv;
+    force.resize(n);
+    dynamics.forces(state, force);
+    v.resize(n);
+    for (std::size_t i = 0; i < n; ++i) v.set(i, state.motion.get(i) / h);
+    spring_jacobian_times(topology, state.position, springs, v, kv);
+
+    // b = h (F + M g - c M v + h K v); pinned rows are zero (their dv is held at 0).
+    Vec3Array b;
+    b.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state.pinned[i]) continue;
+        const float m = state.mass[i];
+        b.set(i, h * (force.get(i) + m * dynamics.gravity - c * m * v.get(i) + h * kv.get(i)));
+    }
+    // A u = (1 + h c) M u - h^2 K u, with pinned rows and columns filtered out.
+    auto apply = [&](const Vec3Array& u, Vec3Array& out) {
+        Vec3Array ku;
+        spring_jacobian_times(topology, state.position, springs, u, ku);
+        out.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (state.pinned[i]) continue;
+            out.set(i, (1.0f + h * c) * state.mass[i] * u.get(i) - (h * h) * ku.get(i));
+        }
+    };
+
+    // Conjugate gradients from dv = 0.
+    Vec3Array dv, r = b, p = b, ap;
+    dv.resize(n);
+    const double b_norm2 = dot(b, b);
+    double r2 = b_norm2;
+    const double stop2 = double(tolerance) * double(tolerance) * b_norm2;
+    int iterations = 0;
+    const int max_iterations = 2000;
+    while (r2 > stop2 && r2 > 0.0 && iterations < max_iterations) {
+        apply(p, ap);
+        const double pap = dot(p, ap);
+        if (!(pap > 0.0)) break;  // not positive definite along p: stop with what we have
+        const float alpha = static_cast<float>(r2 / pap);
+        for (std::size_t i = 0; i < n; ++i) {
+            dv.add(i, alpha * p.get(i));
+            r.add(i, -alpha * ap.get(i));
+        }
+        const double r2_new = dot(r, r);
+        const float beta = static_cast<float>(r2_new / r2);
+        for (std::size_t i = 0; i < n; ++i) p.set(i, r.get(i) + beta * p.get(i));
+        r2 = r2_new;
+        ++iterations;
+    }
+
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state.pinned[i]) {
+            state.motion.set(i, glm::vec3(0.0f));
+            continue;
+        }
+        const glm::vec3 moved = (v.get(i) + dv.get(i)) * h;
+        state.motion.set(i, moved);
+        state.position.add(i, moved);
+    }
+    return iterations;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,139 @@
+// The integrators against the analytic (damped) oscillator: observed convergence orders by halving the step,
+// the size of the error, switching integrators mid-run, and what each does with pins, colliders and stiff
+// springs.
+#include "support.hpp"
+
+#include "clothsim/colliders.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace clothsim;
+
+namespace {
+
+// One particle of mass m on a spring k, the other end pinned; displaced by A and released at rest. Returns
+// the largest |u(t) - u_exact(t)| over two periods, for `substeps_per_period` substeps per period.
+double oscillator_error(Integrator integrator, int substeps_per_period, double c) {
+    const double m = 0.1, k = 100.0, amplitude = 0.05, rest = 0.5;
+    const double w = std::sqrt(k / m), gamma = 0.5 * c, wd = std::sqrt(w * w - gamma * gamma);
+    const double period = 2.0 * std::numbers::pi / w, h = period / substeps_per_period;
+    Scene s = test::chain(2, static_cast<float>(rest), static_cast<float>(m), static_cast<float>(k));
+    s.pins.particles = {{0, 0}};
+    s.settings.springs.damping = static_cast<float>(c);
+    s.settings.integration.dt = static_cast<float>(h);
+    s.settings.integration.integrator = integrator;
+    s.settings.integration.tolerance = 1e-7f;
+    MassSpring sim = build_simulation(s);
+    sim.set_particle(1, {0.0f, static_cast<float>(-rest - amplitude), 0.0f}, glm::vec3(0.0f));
+    double worst = 0.0;
+    const long long steps = std::llround(2.0 * period / h);
+    for (long long i = 0; i < steps; ++i) {
+        sim.step();
+        const double t = sim.time();
+        const double exact = amplitude * std::exp(-gamma * t) * (std::cos(wd * t) + gamma / wd * std::sin(wd * t));
+        worst = std::max(worst, std::fabs(-(double(sim.position(1).y) + rest) - exact));
+    }
+    return worst;
+}
+
+// Observed order from errors at n and 2n substeps per period.
+double order(Integrator integrator, int n, double c) {
+    return std::log2(oscillator_error(integrator, n, c) / oscillator_error(integrator, 2 * n, c));
+}
+
+}  // namespace
+
+TEST_CASE("integrators observed convergence orders: symplectic Euler 1, RK4 4, implicit Euler 1", "[integrators]") {
+    for (double c : {0.0, 2.0}) {
+        INFO("damping " << c << " 1/s");
+        CHECK(order(Integrator::Verlet, 50, c) == Approx(2.0).margin(0.1));
+        CHECK(order(Integrator::SymplecticEuler, 100, c) == Approx(1.0).margin(0.15));
+        CHECK(order(Integrator::SymplecticEuler, 200, c) == Approx(1.0).margin(0.1));
+        // RK4's error reaches float round-off (1e-7 of 0.5 m) below about 50 substeps per period.
+        CHECK(order(Integrator::Rk4, 12, c) == Approx(4.0).margin(0.3));
+        CHECK(order(Integrator::Rk4, 25, c) == Approx(4.0).margin(0.3));
+        CHECK(order(Integrator::ImplicitEuler, 400, c) == Approx(1.0).margin(0.15));
+    }
+}
+
+TEST_CASE("integrators match the analytic damped oscillator within their expected error", "[integrators]") {
+    // At 100 substeps per period (w h = 0.063) and amplitude 5 cm: a first-order method errs by O(w h) of the
+    // amplitude, second order by O((w h)^2), fourth by O((w h)^4).
+    const double amplitude = 0.05;
+    for (double c : {0.0, 2.0, 8.0}) {
+        INFO("damping " << c << " 1/s");
+        CHECK(oscillator_error(Integrator::Verlet, 100, c) < 0.01 * amplitude);
+        CHECK(oscillator_error(Integrator::SymplecticEuler, 100, c) < 0.06 * amplitude);
+        CHECK(oscillator_error(Integrator::Rk4, 100, c) < 1e-4 * amplitude);
+        CHECK(oscillator_error(Integrator::ImplicitEuler, 100, c) < 0.4 * amplitude);
+        CHECK(oscillator_error(Integrator::Xpbd, 100, c) < 0.4 * amplitude);
+    }
+}
+
+TEST_CASE("integrators XPBD approaches the spring model as the substeps grow", "[integrators]") {
+    double previous = INFINITY;
+    for (int n : {50, 100, 200, 400, 800}) {
+        const double e = oscillator_error(Integrator::Xpbd, n, 0.0);
+        INFO(n << " substeps per period: error " << e);
+        CHECK(e < 0.6 * previous);  // roughly halves with the substep
+        previous = e;
+    }
+    CHECK(previous < 0.005 * 0.05 * 10);  // under 2.5 mm of the 5 cm swing at 800 substeps per period
+}
+
+TEST_CASE("integrators switching mid-run keeps position and velocity", "[integrators]") {
+    Scene s = test::chain(1, 1.0f, 1.0f, 0.0f);
+    s.settings.forces.gravity = {0.0f, -9.81f, 0.0f};
+    s.settings.integration.dt = 0.001f;
+    MassSpring sim = build_simulation(s);
+    for (Integrator next : {Integrator::Rk4, Integrator::SymplecticEuler, Integrator::ImplicitEuler,
+                            Integrator::Xpbd, Integrator::Verlet}) {
+        sim.run_steps(100);
+        sim.settings().integration.integrator = next;
+    }
+    sim.run_steps(100);  // 0.6 s of free fall through five integrators
+    CHECK(sim.velocities()[0].y == Approx(-9.81 * 0.6).epsilon(2e-3));
+    CHECK(sim.position(0).y == Approx(-0.5 * 9.81 * 0.36).epsilon(5e-3));
+}
+
+TEST_CASE("integrators implicit Euler stays stable far beyond the explicit step limit", "[integrators]") {
+    Scene s = load_scene("hanging");
+    s.cloth.rows = s.cloth.cols = 16;
+    s.settings.integration.substeps = 1;  // h = 16.7 ms: about 20x Verlet's limit for these springs
+    s.settings.springs.damping = 0.0f;
+    s.settings.integration.integrator = Integrator::Verlet;
+    MassSpring verlet = build_simulation(s);
+    verlet.run_steps(60);
+    CHECK_FALSE(verlet.all_finite());  // explicit: blows up
+    s.settings.integration.integrator = Integrator::ImplicitEuler;
+    MassSpring implicit = build_simulation(s);
+    const double e0 = implicit.energy().total();
+    implicit.run_steps(60);
+    CHECK(implicit.all_finite());
+    CHECK(implicit.energy().total() < e0);  // backward Euler only dissipates
+    CHECK(implicit.last_solver_iterations() > 0);
+}
+
+TEST_CASE("integrators all keep pins fixed and particles outside the colliders", "[integrators]") {
+    for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::Rk4, Integrator::ImplicitEuler,
+                                  Integrator::Xpbd}) {
+        Scene s = load_scene("drape-sphere");
+        s.cloth.rows = s.cloth.cols = 20;
+        s.pins.particles = {{0, 0}};
+        s.settings.integration.integrator = integrator;
+        MassSpring sim = build_simulation(s);
+        const glm::vec3 pin = sim.position(0);
+        sim.run_steps(90);
+        INFO("integrator " << static_cast<int>(integrator));
+        CHECK(sim.all_finite());
+        CHECK(sim.position(0) == pin);
+        for (std::size_t i = 1; i < sim.particle_count(); ++i) {
+            CHECK(signed_distance(s.settings.colliders.sphere, sim.position(i)) >= 0.0f);
+            CHECK(signed_distance(s.settings.colliders.ground, sim.position(i)) >= 0.0f);
+        }
+    }
+}

@@ -3,6 +3,7 @@
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
+#include "work_precision.hpp"
 
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
@@ -90,11 +91,22 @@ int main(int argc, char** argv) {
     app.add_option("--budget-ms", budget_ms, "Frame budget for the substeps-per-frame figure")->capture_default_str();
     app.add_option("--csv", csv_path, "Write the table as CSV");
     app.add_option("--json", json_path, "Write the table and the frame budget as JSON");
+    bench::WorkPrecisionOptions wp;
+    CLI::App* work_precision =
+        app.add_subcommand("work-precision", "Run time against error for every integrator (docs/ACCURACY.md)");
+    work_precision->add_option("--scenes", wp.scenes, "Study scenes: smooth, drape, flag")->delimiter(',');
+    work_precision->add_option("--integrators", wp.integrators, "Integrators to sweep")->delimiter(',');
+    work_precision->add_option("--T", wp.duration, "Simulated seconds per run")->check(CLI::PositiveNumber);
+    work_precision->add_option("--levels", wp.levels, "Step sizes per integrator (halving)")->check(CLI::Range(1, 20));
+    work_precision->add_option("--repeats", wp.repeats, "Timed repetitions (median)")->check(CLI::Range(1, 50));
+    work_precision->add_option("--csv", wp.csv, "Write the sweep as CSV");
+    work_precision->add_option("--plots", wp.plot_dir, "Write accuracy-SCENE.png here (needs --csv; gnuplot)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
     }
+    if (*work_precision) return bench::run_work_precision(wp);
 
     std::vector<Row> rows;
     try {

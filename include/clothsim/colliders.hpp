@@ -29,8 +29,10 @@ void collide(State& state, const CubeCollider& cube, float thickness, std::size_
              std::size_t end = kAllParticles);
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
-// Every enabled collider, in the order sphere, cube, ground.
-void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
+// Every enabled collider, in the order sphere, cube, ground. For float (the simulation) and double (the
+// reference solution).
+template <class T>
+void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
 
 }  // namespace clothsim

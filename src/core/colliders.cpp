@@ -5,50 +5,56 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace clothsim {
 namespace {
 
-// Where a particle touches a collider: the outward unit normal and how far to move along it.
+// Where a particle touches a collider: the outward unit normal and how far to move along it. Templates on
+// the scalar: float for the simulation, double for the reference solution.
+template <class T>
 struct Contact {
-    glm::vec3 normal{0.0f, 1.0f, 0.0f};
-    float depth = 0.0f;  // > 0 when the particle is closer than `thickness`
+    glm::vec<3, T> normal{T(0), T(1), T(0)};
+    T depth = T(0);  // > 0 when the particle is closer than `thickness`
 };
 
-Contact contact(const SphereCollider& sphere, glm::vec3 p, float thickness) {
-    const glm::vec3 d = p - sphere.center;
-    const float length = glm::length(d);
-    Contact c;
+template <class T>
+Contact<T> contact(const SphereCollider& sphere, glm::vec<3, T> p, T thickness) {
+    const glm::vec<3, T> d = p - glm::vec<3, T>(sphere.center);
+    const T length = glm::length(d);
+    Contact<T> c;
     // A particle exactly at the centre has no direction: push it straight up.
-    if (length > 1e-12f) c.normal = d / length;
-    c.depth = sphere.radius + thickness - length;
+    if (length > T(1e-12f)) c.normal = d / length;
+    c.depth = T(sphere.radius) + thickness - length;
     return c;
 }
 
-Contact contact(const CubeCollider& cube, glm::vec3 p, float thickness) {
-    const glm::vec3 local = p - cube.center;
-    const glm::vec3 q = glm::abs(local) - 0.5f * cube.size;  // per-axis distance outside a face
-    const glm::vec3 side(local.x < 0.0f ? -1.0f : 1.0f, local.y < 0.0f ? -1.0f : 1.0f,
-                         local.z < 0.0f ? -1.0f : 1.0f);
-    Contact c;
-    const float q_max = std::max({q.x, q.y, q.z});
-    if (q_max <= 0.0f) {
+template <class T>
+Contact<T> contact(const CubeCollider& cube, glm::vec<3, T> p, T thickness) {
+    using Vec = glm::vec<3, T>;
+    const Vec local = p - Vec(cube.center);
+    const Vec q = glm::abs(local) - T(0.5) * Vec(cube.size);  // per-axis distance outside a face
+    const Vec side(local.x < T(0) ? T(-1) : T(1), local.y < T(0) ? T(-1) : T(1), local.z < T(0) ? T(-1) : T(1));
+    Contact<T> c;
+    const T q_max = std::max({q.x, q.y, q.z});
+    if (q_max <= T(0)) {
         // Inside or on the surface: leave through the nearest face (the axis with the largest q).
         const int axis = q.x == q_max ? 0 : (q.y == q_max ? 1 : 2);
-        c.normal = glm::vec3(0.0f);
+        c.normal = Vec(T(0));
         c.normal[axis] = side[axis];
         c.depth = thickness - q_max;
         return c;
     }
-    const glm::vec3 outside = glm::max(q, glm::vec3(0.0f)) * side;
-    const float distance = glm::length(outside);
+    const Vec outside = glm::max(q, Vec(T(0))) * side;
+    const T distance = glm::length(outside);
     c.normal = outside / distance;
     c.depth = thickness - distance;
     return c;
 }
 
-Contact contact(const GroundCollider& ground, glm::vec3 p, float thickness) {
-    return {glm::vec3(0.0f, 1.0f, 0.0f), ground.height + thickness - p.y};
+template <class T>
+Contact<T> contact(const GroundCollider& ground, glm::vec<3, T> p, T thickness) {
+    return {glm::vec<3, T>(T(0), T(1), T(0)), T(ground.height) + thickness - p.y};
 }
 
 // Cheap tests, written so the compiler vectorises them, of whether any particle of a range is close
@@ -79,27 +85,29 @@ bool any_near(const State& state, const GroundCollider& ground, float thickness,
     return any;
 }
 
-template <class Shape>
-void collide_shape(State& state, const Shape& shape, float friction, float thickness, std::size_t begin,
+template <class T, class Shape>
+void collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
                    std::size_t end) {
-    // NaN positions fail every compare above; they stay NaN either way (the guard reports them).
-    if (!any_near(state, shape, thickness, begin, end)) return;
+    using Vec = glm::vec<3, T>;
+    // NaN positions fail every compare in any_near; they stay NaN either way (the guard reports them).
+    if constexpr (std::is_same_v<T, float>) {
+        if (!any_near(state, shape, thickness, begin, end)) return;
+    }
     for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
-        const Contact c = contact(shape, state.position.get(i), thickness);
-        if (!(c.depth > 0.0f)) continue;
-        const glm::vec3 motion = state.motion.get(i);
-        const float normal_motion = glm::dot(motion, c.normal);
-        const glm::vec3 tangential = motion - normal_motion * c.normal;
+        const Contact<T> c = contact(shape, state.position.get(i), thickness);
+        if (!(c.depth > T(0))) continue;
+        const Vec motion = state.motion.get(i);
+        const T normal_motion = glm::dot(motion, c.normal);
+        const Vec tangential = motion - normal_motion * c.normal;
         // Coulomb: the tangential motion loses at most mu times the normal push (static when it is less).
-        const float slide = glm::length(tangential);
-        const glm::vec3 friction_cut =
-            slide > 0.0f ? -tangential * (std::min(slide, friction * c.depth) / slide) : glm::vec3(0.0f);
+        const T slide = glm::length(tangential);
+        const Vec friction_cut = slide > T(0) ? -tangential * (std::min(slide, friction * c.depth) / slide) : Vec(T(0));
         state.position.add(i, c.normal * c.depth + friction_cut);
         // Inelastic contact: the push moves the particle out but does not launch it. Keeping the push in
         // the motion (x_prev left in place, as plain Verlet projection does) turns a deep penetration into a
         // velocity of depth / h: a cloth started half inside the sphere exploded that way.
-        state.motion.set(i, tangential + friction_cut + std::max(normal_motion, 0.0f) * c.normal);
+        state.motion.set(i, tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal);
     }
 }
 
@@ -116,6 +124,17 @@ float signed_distance(const CubeCollider& cube, glm::vec3 p) {
 
 float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
 
+template <class T>
+void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
+    end = std::min(end, state.size());
+    const T thickness = colliders.thickness;
+    if (colliders.sphere.enabled) collide_shape(state, colliders.sphere, T(colliders.sphere.friction), thickness, begin, end);
+    if (colliders.cube.enabled) collide_shape(state, colliders.cube, T(colliders.cube.friction), thickness, begin, end);
+    if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
+}
+template void collide_all<float>(State&, const ColliderSettings&, std::size_t, std::size_t);
+template void collide_all<double>(DState&, const ColliderSettings&, std::size_t, std::size_t);
+
 void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
     collide_shape(state, sphere, sphere.friction, thickness, begin, std::min(end, state.size()));
 }
@@ -126,10 +145,5 @@ void collide(State& state, const GroundCollider& ground, float thickness, std::s
     collide_shape(state, ground, ground.friction, thickness, begin, std::min(end, state.size()));
 }
 
-void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
-    if (colliders.sphere.enabled) collide(state, colliders.sphere, colliders.thickness, begin, end);
-    if (colliders.cube.enabled) collide(state, colliders.cube, colliders.thickness, begin, end);
-    if (colliders.ground.enabled) collide(state, colliders.ground, colliders.thickness, begin, end);
-}
 
 }  // namespace clothsim

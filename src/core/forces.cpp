@@ -8,22 +8,25 @@
 
 namespace clothsim {
 
-void accumulate_spring_forces(const Topology& topology, const Vec3Array& position,
-                              const SpringSettings& springs, Vec3Array& force) {
-    const std::array<float, kSpringKindCount> k = {springs.structural, springs.shear, springs.bending};
+template <class T>
+void accumulate_spring_forces(const Topology& topology, const BasicVec3Array<T>& position,
+                              const SpringSettings& springs, BasicVec3Array<T>& force) {
+    using Vec = glm::vec<3, T>;
+    const std::array<T, kSpringKindCount> k = {springs.structural, springs.shear, springs.bending};
     for (const Spring& s : topology.springs) {
-        const float ks = k[static_cast<int>(s.kind)];
-        if (ks == 0.0f) continue;
-        const glm::vec3 d = position.get(s.b) - position.get(s.a);
-        float scale;  // f_a = scale * d
-        if (s.rest_length == 0.0f) {
+        const T ks = k[static_cast<int>(s.kind)];
+        if (ks == T(0)) continue;
+        const Vec d = position.get(s.b) - position.get(s.a);
+        const T rest = s.rest_length;
+        T scale;  // f_a = scale * d
+        if (rest == T(0)) {
             scale = ks;
         } else {
-            const float length = glm::length(d);
-            if (!(length > 1e-12f)) continue;
-            scale = ks * (length - s.rest_length) / length;
+            const T length = glm::length(d);
+            if (!(length > T(1e-12f))) continue;
+            scale = ks * (length - rest) / length;
         }
-        const glm::vec3 f = scale * d;
+        const Vec f = scale * d;
         force.add(s.a, f);
         force.add(s.b, -f);
     }
@@ -36,35 +39,43 @@ glm::vec3 wind_velocity(const ForceSettings& forces, double time) {
     return forces.wind * static_cast<float>(1.0 + forces.gust_strength * gust);
 }
 
-void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
-                            float rest_area, Vec3Array& force) {
-    const glm::vec3 wind = wind_velocity(forces, state.time);
-    const float inv_h = state.substep > 0.0f ? 1.0f / state.substep : 0.0f;
-    auto velocity = [&](std::size_t i) {
-        return state.motion.get(i) * inv_h;
-    };
+template <class T>
+void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state, const ForceSettings& forces,
+                            T rest_area, BasicVec3Array<T>& force) {
+    using Vec = glm::vec<3, T>;
+    const Vec wind(wind_velocity(forces, state.time));
+    const T drag = forces.drag;
+    const T inv_h = state.substep > T(0) ? T(1) / state.substep : T(0);
+    auto velocity = [&](std::size_t i) { return state.motion.get(i) * inv_h; };
     if (forces.wind_model == WindModel::Uniform) {
-        const float area = rest_area / static_cast<float>(state.size());
+        const T area = rest_area / static_cast<T>(state.size());
         for (std::size_t i = 0; i < state.size(); ++i) {
-            const glm::vec3 rel = wind - velocity(i);
-            force.add(i, forces.drag * area * glm::length(rel) * rel);
+            const Vec rel = wind - velocity(i);
+            force.add(i, drag * area * glm::length(rel) * rel);
         }
         return;
     }
     for (const auto& t : topology.triangles) {
-        const glm::vec3 a = state.position.get(t[0]);
-        const glm::vec3 cross = glm::cross(state.position.get(t[1]) - a, state.position.get(t[2]) - a);
-        const float twice_area = glm::length(cross);
-        if (!(twice_area > 1e-12f)) continue;
-        const glm::vec3 n = cross / twice_area;
-        const glm::vec3 v = (velocity(t[0]) + velocity(t[1]) + velocity(t[2])) * (1.0f / 3.0f);
-        const float wn = glm::dot(wind - v, n);
-        const glm::vec3 f = (forces.drag * 0.5f * twice_area * wn * std::fabs(wn) / 3.0f) * n;
+        const Vec a = state.position.get(t[0]);
+        const Vec cross = glm::cross(state.position.get(t[1]) - a, state.position.get(t[2]) - a);
+        const T twice_area = glm::length(cross);
+        if (!(twice_area > T(1e-12f))) continue;
+        const Vec n = cross / twice_area;
+        const Vec v = (velocity(t[0]) + velocity(t[1]) + velocity(t[2])) * (T(1) / T(3));
+        const T wn = glm::dot(wind - v, n);
+        const Vec f = (drag * T(0.5) * twice_area * wn * std::abs(wn) / T(3)) * n;
         force.add(t[0], f);
         force.add(t[1], f);
         force.add(t[2], f);
     }
 }
+
+template void accumulate_spring_forces<float>(const Topology&, const Vec3Array&, const SpringSettings&, Vec3Array&);
+template void accumulate_spring_forces<double>(const Topology&, const DVec3Array&, const SpringSettings&,
+                                               DVec3Array&);
+template void accumulate_wind_forces<float>(const Topology&, const State&, const ForceSettings&, float, Vec3Array&);
+template void accumulate_wind_forces<double>(const Topology&, const DState&, const ForceSettings&, double,
+                                             DVec3Array&);
 
 double spring_potential_energy(const Topology& topology, const Vec3Array& position,
                                const SpringSettings& springs) {

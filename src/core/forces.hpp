@@ -9,8 +9,10 @@ namespace clothsim {
 // Hooke springs, F_a = k (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
-void accumulate_spring_forces(const Topology& topology, const Vec3Array& position,
-                              const SpringSettings& springs, Vec3Array& force);
+// Instantiated for float (the simulation) and double (the reference solution).
+template <class T>
+void accumulate_spring_forces(const Topology& topology, const BasicVec3Array<T>& position,
+                              const SpringSettings& springs, BasicVec3Array<T>& force);
 
 // Air velocity at a time: the wind vector scaled by deterministic gusts (two incommensurate sines, so a
 // run is reproducible and still looks irregular).
@@ -20,8 +22,9 @@ glm::vec3 wind_velocity(const ForceSettings& forces, double time);
 // velocity v of its corners, feels F = drag * A * (w_rel . n) |w_rel . n| n with w_rel = w - v, shared
 // equally by its corners; a sheet edge-on to the wind feels nothing. Uniform model: every particle feels
 // drag * (A_total / N) * |w_rel| w_rel. Velocities are the first-order (x - x_prev) / h.
-void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
-                            float rest_area, Vec3Array& force);
+template <class T>
+void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state, const ForceSettings& forces,
+                            T rest_area, BasicVec3Array<T>& force);
 
 // Elastic energy 0.5 k (|d| - L0)^2 summed over springs (J).
 double spring_potential_energy(const Topology& topology, const Vec3Array& position,

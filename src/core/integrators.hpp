@@ -12,25 +12,32 @@
 namespace clothsim {
 
 // Forces (N) at a state: reads positions and, for wind, motion / substep as the velocity.
-using ForceFunction = std::function<void(const State&, Vec3Array&)>;
+template <class T>
+using BasicForceFunction = std::function<void(const BasicState<T>&, BasicVec3Array<T>&)>;
+using ForceFunction = BasicForceFunction<float>;
 
 // What every integrator needs besides the state.
-struct Dynamics {
-    const ForceFunction& forces;    // springs and wind
-    const ForceFunction& external;  // wind only (XPBD treats springs as constraints)
-    glm::vec3 gravity;              // m/s^2
-    float damping;                  // 1/s: a = F/m + g - c v
+template <class T>
+struct BasicDynamics {
+    const BasicForceFunction<T>& forces;    // springs and wind
+    const BasicForceFunction<T>& external;  // wind only (XPBD treats springs as constraints)
+    glm::vec3 gravity;                      // m/s^2
+    float damping;                          // 1/s: a = F/m + g - c v
 };
+using Dynamics = BasicDynamics<float>;
 
-// a = F/m + g - c v for free particles, 0 for pinned ones; v = motion / h.
-void accelerations(const State& state, const Vec3Array& force, glm::vec3 gravity, float damping,
-                   Vec3Array& out);
+// a = F/m + g - c v for free particles, 0 for pinned ones; v = motion / h. Float and double.
+template <class T>
+void accelerations(const BasicState<T>& state, const BasicVec3Array<T>& force, glm::vec3 gravity, float damping,
+                   BasicVec3Array<T>& out);
 
 // Semi-implicit Euler: v' = v + h a(x, v), x' = x + h v'. First order; symplectic without damping.
 void step_symplectic_euler(State& state, const Dynamics& dynamics, float h);
 
-// Classical Runge-Kutta on (x, v): four force evaluations, fourth order.
-void step_rk4(State& state, const Dynamics& dynamics, float h);
+// Classical Runge-Kutta on (x, v): four force evaluations, fourth order. Float, and double for the
+// reference solution.
+template <class T>
+void step_rk4(BasicState<T>& state, const BasicDynamics<T>& dynamics, T h);
 
 // Backward Euler linearised once (Baraff & Witkin 1998):
 //   ((1 + h c) M - h^2 K) dv = h (F + M g - c M v + h K v),   v' = v + dv,   x' = x + h v'

@@ -2,15 +2,22 @@
 
 namespace clothsim {
 
-void accelerations(const State& state, const Vec3Array& force, glm::vec3 gravity, float damping, Vec3Array& out) {
+template <class T>
+void accelerations(const BasicState<T>& state, const BasicVec3Array<T>& force, glm::vec3 gravity, float damping,
+                   BasicVec3Array<T>& out) {
+    using Vec = glm::vec<3, T>;
     out.resize(state.size());
-    const float inv_h = state.substep > 0.0f ? 1.0f / state.substep : 0.0f;
+    const T inv_h = state.substep > T(0) ? T(1) / state.substep : T(0);
+    const Vec g(gravity);
+    const T c = damping;
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
-        const glm::vec3 v = state.motion.get(i) * inv_h;
-        out.set(i, force.get(i) * state.inverse_mass[i] + gravity - damping * v);
+        const Vec v = state.motion.get(i) * inv_h;
+        out.set(i, force.get(i) * state.inverse_mass[i] + g - c * v);
     }
 }
+template void accelerations<float>(const State&, const Vec3Array&, glm::vec3, float, Vec3Array&);
+template void accelerations<double>(const DState&, const DVec3Array&, glm::vec3, float, DVec3Array&);
 
 void step_symplectic_euler(State& state, const Dynamics& dynamics, float h) {
     Vec3Array force, a;

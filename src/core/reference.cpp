@@ -1,0 +1,99 @@
+#include "clothsim/reference.hpp"
+
+#include "clothsim/colliders.hpp"
+#include "clothsim/scene.hpp"
+#include "forces.hpp"
+#include "integrators.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace clothsim {
+
+std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, double h) {
+    // The float builder gives the topology and the start; the state is then carried in double.
+    const MassSpring start = build_simulation(scene);
+    const State& f = start.state();
+    const std::size_t n = f.size();
+    DState state;
+    state.position.resize(n);
+    state.motion.resize(n);
+    state.mass.assign(f.mass.begin(), f.mass.end());
+    state.inverse_mass.assign(f.inverse_mass.begin(), f.inverse_mass.end());
+    state.pinned = f.pinned;
+    state.substep = h;
+    const glm::dvec3 velocity(scene.cloth.velocity);
+    for (std::size_t i = 0; i < n; ++i) {
+        state.position.set(i, glm::dvec3(f.position.get(i)));
+        if (!state.pinned[i]) state.motion.set(i, velocity * h);
+    }
+    const SimulationSettings& settings = scene.settings;
+    const Topology& topology = start.topology();
+    const double rest_area = start.rest_area();
+    const bool wind = settings.forces.wind != glm::vec3(0.0f) || settings.forces.wind_model == WindModel::Uniform;
+    const BasicForceFunction<double> forces = [&](const DState& s, DVec3Array& out) {
+        out.resize(s.size());
+        accumulate_spring_forces(topology, s.position, settings.springs, out);
+        if (wind) {
+            DVec3Array w;
+            w.resize(s.size());
+            accumulate_wind_forces(topology, s, settings.forces, rest_area, w);
+            for (std::size_t i = 0; i < s.size(); ++i) out.add(i, w.get(i));
+        }
+    };
+    const BasicDynamics<double> dynamics{forces, forces, settings.forces.gravity, settings.springs.damping};
+    const long long steps = std::llround(duration / h);
+    for (long long s = 0; s < steps; ++s) {
+        step_rk4(state, dynamics, h);
+        collide_all(state, settings.colliders);
+        state.time += h;
+    }
+    std::vector<glm::dvec3> out(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = state.position.get(i);
+    return out;
+}
+
+double cloth_size(const Scene& scene) { return std::max(scene.cloth.size.x, scene.cloth.size.y); }
+
+ErrorNorms relative_error(const std::vector<glm::dvec3>& positions, const std::vector<glm::dvec3>& reference,
+                          double size) {
+    ErrorNorms e;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const double d = glm::length(positions[i] - reference[i]) / size;
+        sum += d * d;
+        e.max = std::max(e.max, d);
+    }
+    e.rms = positions.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(positions.size()));
+    return e;
+}
+
+ErrorNorms relative_error(const MassSpring& sim, const std::vector<glm::dvec3>& reference, double size) {
+    std::vector<glm::dvec3> p(sim.particle_count());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = glm::dvec3(sim.position(i));
+    return relative_error(p, reference, size);
+}
+
+Reference reference_solution(const Scene& scene, double duration, double first_substep, double tolerance,
+                             int max_halvings) {
+    Reference ref;
+    double h = first_substep;
+    std::vector<glm::dvec3> coarse = run_double_rk4(scene, duration, h);
+    for (ref.halvings = 1; ref.halvings <= max_halvings; ++ref.halvings) {
+        h *= 0.5;
+        std::vector<glm::dvec3> fine = run_double_rk4(scene, duration, h);
+        ref.halving_change = relative_error(coarse, fine, cloth_size(scene)).max;
+        ref.positions = std::move(fine);
+        ref.substep = h;
+        if (ref.halving_change < tolerance) {
+            ref.converged = true;
+            break;
+        }
+        coarse = ref.positions;
+    }
+    return ref;
+}
+
+}  // namespace clothsim

@@ -69,8 +69,8 @@ public:
     Energy energy() const;
     glm::vec3 momentum() const;  // kg m/s, free particles
     bool all_finite() const;
-    // Whether settings().solver.method == Fast really runs the fast grid solver (it needs a grid topology),
-    // and with how many threads.
+    // Whether settings().solver.method == Fast can run the fast grid solver (it needs a grid topology; it
+    // runs position Verlet), and with how many threads the current settings step.
     bool fast_solver_available() const { return grid_ != nullptr; }
     int solver_threads() const;
     // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).

@@ -340,16 +340,45 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
                     app.stats.render_ms);
         ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                     app.sim.time());
-        const bool fast = app.sim.fast_solver_available() && app.scene.settings.solver.method == SolverMethod::Fast;
+        // The fast solver runs position Verlet; every other integrator uses the shared textbook force path.
+        const bool fast = app.sim.fast_solver_available() && app.scene.settings.solver.method == SolverMethod::Fast &&
+                          app.scene.settings.integration.integrator == Integrator::Verlet;
         const double per_substep_us = app.stats.substeps_last_frame > 0
                                           ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
                                           : 0.0;
-        ImGui::Text("solver: %s (%s, %d thread%s), %.1f us per substep", fast ? "fast" : "textbook",
-                    fast ? MassSpring::fast_kernel_name() : "spring list", app.sim.solver_threads(),
-                    app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
+        if (fast) {
+            ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep", MassSpring::fast_kernel_name(),
+                        app.sim.solver_threads(), app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
+        } else {
+            ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);
+        }
         if (app.stats.dropped_seconds > 0.0) {
             ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
                                app.stats.dropped_seconds);
+        }
+        // Accuracy hint: how much total energy moved over the plotted window. With no damping, no wind and no
+        // contact it should stay put, and its drift measures the integrator's error at this step.
+        const Integrator integrator = app.scene.settings.integration.integrator;
+        ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
+                    integrator == Integrator::ImplicitEuler
+                        ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations").c_str()
+                        : "");
+        if (app.stats.total.size() > 1) {
+            const History& e = app.stats.total;
+            const float first = e.values[static_cast<std::size_t>(e.offset())];
+            const float drift = (e.last() - first) / std::max(std::fabs(first), 1e-6f);
+            const bool conservative = app.scene.settings.springs.damping == 0.0f &&
+                                      app.scene.settings.forces.wind == glm::vec3(0.0f);
+            ImGui::TextColored(conservative && std::fabs(drift) > 0.01f ? ImVec4(1.0f, 0.6f, 0.3f, 1.0f)
+                                                                        : ImVec4(0.8f, 0.8f, 0.8f, 1.0f),
+                               "energy drift over the plot: %+.3g%%%s", 100.0 * drift,
+                               conservative ? " (error)" : "");
+            if (ImGui::IsItemHovered()) {
+                ImGui::SetTooltip("relative change of total energy over the last %d frames; with no damping,\n"
+                                  "wind or contact it is integration error. docs/ACCURACY.md compares the\n"
+                                  "integrators' errors against run time.",
+                                  e.size());
+            }
         }
         plot("kinetic", app.stats.kinetic, ImVec4(1.0f, 0.6f, 0.3f, 1.0f));
         plot("potential", app.stats.potential, ImVec4(0.4f, 0.7f, 1.0f, 1.0f));

@@ -54,8 +54,9 @@ MassSpring& MassSpring::operator=(const MassSpring& other) {
 const char* MassSpring::fast_kernel_name() { return GridSolver::kernel_name(); }
 
 int MassSpring::solver_threads() const {
-    return grid_ && settings_.solver.method == SolverMethod::Fast ? grid_->effective_threads(settings_.solver.threads)
-                                                                   : 1;
+    const bool fast = grid_ && settings_.solver.method == SolverMethod::Fast &&
+                      settings_.integration.integrator == Integrator::Verlet;
+    return fast ? grid_->effective_threads(settings_.solver.threads) : 1;
 }
 
 float MassSpring::substep_length() const {

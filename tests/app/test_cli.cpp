@@ -212,6 +212,21 @@ TEST_CASE("cli: --obj naming a directory exits 2 before simulating") {
     expect_bad_input({"--headless", "--steps", "1", "--obj", path}, {"--obj", path, "is a directory"});
 }
 
+TEST_CASE("cli: every integrator can be chosen with --set and runs a bundled scene finite") {
+    for (const char* name : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd"}) {
+        const RunResult r = run_clothsim({"--headless", "--scene", "drape-sphere", "--set", "cloth.rows=12", "--set",
+                                          "cloth.cols=12", "--set", std::string("integration.integrator=") + name,
+                                          "--duration", "0.5", "--json"});
+        CAPTURE_RUN(r);
+        INFO(name);
+        REQUIRE(r.code == 0);
+        CHECK(nlohmann::json::parse(r.out).at("finite").get<bool>());
+    }
+    const RunResult bad = run_clothsim({"--headless", "--set", "integration.integrator=euler"});
+    CHECK(bad.code == 2);
+    CHECK_THAT(bad.err, Contains("integration.integrator") && Contains("rk4"));
+}
+
 TEST_CASE("cli: the app without a display exits 2, names the problem and mentions --headless") {
     expect_bad_input({}, {"DISPLAY", "--headless"}, "env -u DISPLAY -u WAYLAND_DISPLAY");
     expect_bad_input({"--scene", "flag", "--frames", "1"}, {"cannot open a window", "--headless"},

@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
     bench::WorkPrecisionOptions wp;
     CLI::App* work_precision =
         app.add_subcommand("work-precision", "Run time against error for every integrator (docs/ACCURACY.md)");
-    work_precision->add_option("--scenes", wp.scenes, "Study scenes: smooth, drape, flag")->delimiter(',');
+    work_precision->add_option("--scene,--scenes", wp.scenes, "Study scenes: smooth, drape, flag")->delimiter(',');
     work_precision->add_option("--integrators", wp.integrators, "Integrators to sweep")->delimiter(',');
     work_precision->add_option("--T", wp.duration, "Simulated seconds per run")->check(CLI::PositiveNumber);
     work_precision->add_option("--levels", wp.levels, "Step sizes per integrator (halving)")->check(CLI::Range(1, 20));

@@ -63,12 +63,14 @@ struct Run {
 
 Run run(const Scene& base, Integrator integrator, double h, double duration, int repeats,
         const std::vector<glm::dvec3>& reference) {
+    // Whole substeps that end exactly at `duration`, so every run is compared at the reference's time.
+    const long long steps = std::max(1LL, std::llround(duration / h));
+    h = duration / static_cast<double>(steps);
     Scene s = base;
     s.settings.integration.integrator = integrator;
     s.settings.integration.dt = static_cast<float>(h);
     s.settings.integration.substeps = 1;
     s.settings.integration.tolerance = 1e-6f;
-    const long long steps = std::llround(duration / h);
     Run r;
     std::vector<double> times;
     for (int k = 0; k < repeats; ++k) {

@@ -14,8 +14,8 @@
 
 namespace clothsim {
 
-// Final positions of `scene` after `duration` seconds of double-precision RK4 at substep `h`
-// (`duration` is rounded to whole substeps).
+// Final positions of `scene` after `duration` seconds of double-precision RK4 at substep `h` (adjusted
+// so that a whole number of substeps ends exactly at `duration`).
 std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, double h);
 
 struct Reference {

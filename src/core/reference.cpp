@@ -13,6 +13,9 @@
 namespace clothsim {
 
 std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, double h) {
+    // Whole substeps that end exactly at `duration`.
+    const long long steps = std::max(1LL, std::llround(duration / h));
+    h = duration / static_cast<double>(steps);
     // The float builder gives the topology and the start; the state is then carried in double.
     const MassSpring start = build_simulation(scene);
     const State& f = start.state();
@@ -44,7 +47,6 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
         }
     };
     const BasicDynamics<double> dynamics{forces, forces, settings.forces.gravity, settings.springs.damping};
-    const long long steps = std::llround(duration / h);
     for (long long s = 0; s < steps; ++s) {
         step_rk4(state, dynamics, h);
         collide_all(state, settings.colliders);

@@ -95,6 +95,12 @@ bool rebuild(AppState& app, Renderer& renderer) {
 // max_catchup_steps per frame so a slow frame slows the simulation instead of spiralling.
 void simulate(AppState& app, double wall_seconds, bool scripted) {
     app.sim.settings() = app.scene.settings;
+    app.limit = stability_limit(app.sim);
+    if (app.auto_substeps) {
+        const int n = auto_substeps(app.limit, app.scene.settings.integration.dt, app.safety);
+        app.scene.settings.integration.substeps = n;
+        app.sim.settings().integration.substeps = n;
+    }
     const double dt = app.scene.settings.integration.dt;
     long long steps = 0;
     if (scripted) {
@@ -115,12 +121,20 @@ void simulate(AppState& app, double wall_seconds, bool scripted) {
     app.step_once = false;
     const auto start = Clock::now();
     if (steps > 0 && app.sim.all_finite()) {
-        app.sim.run_steps(steps);
-        if (!app.sim.all_finite()) {
+        // The guard: a step that blows up is rolled back and retried with twice the substeps; the user is told.
+        std::string log;
+        const bool ok = run_guarded(app.sim, steps, GuardSettings{}, log);
+        if (!log.empty()) {
+            app.scene.settings.integration.substeps = app.sim.settings().integration.substeps;
+            if (app.auto_substeps) {
+                app.auto_substeps = false;
+                log += "auto substeps turned off to keep the guard's choice\n";
+            }
+            app.say(log, !ok);
+        }
+        if (!ok) {
             app.paused = true;
-            app.say("the simulation became non-finite and was paused: lower integration.dt, raise substeps or soften "
-                    "the springs, then press R",
-                    true);
+            app.say(log + "paused at the last good state: lower integration.dt or soften the springs, then play", true);
         }
         record_energy(app);
     }
@@ -350,6 +364,8 @@ int run_app(const Scene& scene, const AppOptions& options) {
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     AppState app(scene, options.scene_source);
+    app.auto_substeps = options.auto_substeps;
+    app.safety = options.safety;
     app.view = options.view;
     app.show_panel = options.show_panel;
     app.save_path = scene.name + "-edited.toml";

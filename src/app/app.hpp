@@ -21,6 +21,9 @@ struct AppOptions {
     std::string screenshot;
     ViewSettings view;       // the View section's start values (--view)
     bool show_panel = true;
+    // Auto substeps (on in interactive runs; scripted runs step exactly what the scene says unless asked).
+    bool auto_substeps = true;
+    float safety = 0.5f;
 };
 
 // Applies one --view item ("wireframe", "springs=strain", "no-shadows", ...); false if unknown.

@@ -7,6 +7,7 @@
 
 #include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
 
 #include <array>
 #include <cstddef>
@@ -64,6 +65,9 @@ struct AppState {
     double accumulator = 0.0;  // s of simulated time owed to the fixed-step loop
     bool show_panel = true;
     bool vsync = true;
+    bool auto_substeps = true;  // pick integration.substeps from the critical substep every frame
+    float safety = 0.5f;        // ... so the substep is this fraction of it
+    StabilityLimit limit;       // of the current cloth and settings, updated every frame
     Stats stats;
     std::optional<Grab> grab;
     std::string status;        // the last message for the user (errors, screenshot path)

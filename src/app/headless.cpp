@@ -2,6 +2,7 @@
 
 #include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,14 @@ bool parent_exists(const std::string& path) {
 int run_headless(const Scene& scene, const HeadlessOptions& options) {
     MassSpring sim = build_simulation(scene);
     const double dt = scene.settings.integration.dt;
+    const StabilityLimit limit = stability_limit(sim);
+    if (options.auto_substeps > 0.0f) {
+        const int chosen = auto_substeps(limit, scene.settings.integration.dt, options.auto_substeps);
+        std::fprintf(stderr, "auto substeps: critical substep %.4g s (Gershgorin), %d substeps per step keep the "
+                             "substep at %.2f of it\n",
+                     limit.critical_substep, chosen, dt / chosen / limit.critical_substep);
+        sim.settings().integration.substeps = chosen;
+    }
     const long long steps = options.steps ? *options.steps
                             : options.duration ? std::llround(*options.duration / dt)
                                                : std::llround(1.0 / dt);
@@ -51,8 +60,17 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     long long done = 0;
     bool finite = sim.all_finite();
-    while (finite && done < steps) {
-        sim.run_steps(1);
+    std::string guard_log;
+    bool guard_ok = true;
+    while (finite && guard_ok && done < steps) {
+        if (options.guard) {
+            std::string log;
+            guard_ok = run_guarded(sim, 1, GuardSettings{}, log);
+            if (!log.empty()) std::cerr << log;
+            guard_log += log;
+        } else {
+            sim.run_steps(1);
+        }
         ++done;
         finite = sim.all_finite();
         if (trajectory && (done % options.every == 0 || done == steps || !finite)) trajectory->record(done, sim);
@@ -71,9 +89,11 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
             code = kExitBadInput;
         }
     }
-    if (!finite) {
-        std::cerr << "clothsim: error: the simulation became non-finite at t = " << sim.time() << " s (step " << done
-                  << "); try a smaller integration.dt, more integration.substeps or softer springs\n";
+    if (!finite || !guard_ok) {
+        std::cerr << "clothsim: error: the simulation " << (finite ? "kept blowing up" : "became non-finite")
+                  << " at t = " << sim.time() << " s (step " << done
+                  << "); try a smaller integration.dt, more integration.substeps, softer springs, or --guard / "
+                     "--auto-substeps\n";
         code = kExitNonFinite;
     }
 
@@ -90,6 +110,11 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
             {"simulated_seconds", sim.time()},
             {"wall_seconds", wall},
             {"finite", finite},
+            {"critical_substep", std::isfinite(limit.critical_substep) ? nlohmann::json(limit.critical_substep)
+                                                                        : nlohmann::json()},
+            {"substep", sim.substep_length()},
+            {"substeps_used", sim.settings().integration.substeps},
+            {"guard_log", guard_log},
             {"kinetic_energy", finite_or_null(e.kinetic)},
             {"potential_energy", finite_or_null(e.potential())},
             {"total_energy", finite_or_null(e.total())},

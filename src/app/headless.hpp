@@ -15,6 +15,8 @@ struct HeadlessOptions {
     long long every = 1;             // record the trajectory every K steps
     std::string obj;                 // OBJ path of the final mesh, empty for none
     bool json = false;
+    float auto_substeps = 0.0f;      // > 0: pick integration.substeps so the substep is this fraction of dt_crit
+    bool guard = false;              // roll back and double the substeps when a step blows up
 };
 
 // Exit codes of the clothsim executable.

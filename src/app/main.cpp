@@ -39,6 +39,12 @@ int main(int argc, char** argv) {
         ->needs(trajectory);
     app.add_option("--obj", options.obj, "Write the final mesh as Wavefront OBJ");
     app.add_flag("--json", options.json, "Print one JSON object with the run's figures on stdout");
+    app.add_option("--auto-substeps", options.auto_substeps,
+                   "Choose integration.substeps so the substep is this fraction of the critical one (the app "
+                   "does this by default at 0.5, except in --frames runs)")
+        ->check(CLI::Range(0.01f, 1.0f));
+    app.add_flag("--guard", options.guard,
+                 "Headless: when a step blows up, roll back, double integration.substeps and retry (says so)");
     app.add_flag("--list-scenes", list_scenes, "List the bundled scenes and exit");
     app.add_flag("--list-fields", list_fields, "List every scene field with its unit and allowed values, and exit");
     app.add_flag("--print-scene", print_scene, "Print the scene (after --set) as TOML and exit");
@@ -102,6 +108,10 @@ int main(int argc, char** argv) {
             }
         }
         app_options.scene_source = scene_name;
+        // Interactive runs pick substeps from the stability limit; scripted ones (--frames) step what the
+        // scene says, so a test can reproduce them, unless --auto-substeps asks otherwise.
+        app_options.auto_substeps = options.auto_substeps > 0.0f || !app_options.frames;
+        if (options.auto_substeps > 0.0f) app_options.safety = options.auto_substeps;
         return run_app(scene, app_options);
     } catch (const SceneError& e) {
         std::cerr << "clothsim: error: " << e.what() << "\n";

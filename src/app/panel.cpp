@@ -290,10 +290,35 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
         }
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
     }
-    if (ImGui::CollapsingHeader("Integration")) {
+    if (ImGui::CollapsingHeader("Integration", ImGuiTreeNodeFlags_DefaultOpen)) {
+        // Stability: the critical substep, where this one stands against it, and the auto choice.
+        ImGui::Checkbox("auto substeps", &app.auto_substeps);
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("choose substeps every frame so the substep stays at the safety fraction of the\n"
+                              "critical substep (Gershgorin bound, docs/STABILITY.md)");
+        }
+        if (app.auto_substeps) {
+            ImGui::SameLine();
+            ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
+            ImGui::SliderFloat("safety", &app.safety, 0.05f, 1.0f, "%.2f");
+        }
+        const StabilityLimit& limit = app.limit;
+        const double substep = double(app.scene.settings.integration.dt) / app.scene.settings.integration.substeps;
+        if (limit.unconditionally_stable) {
+            ImGui::TextColored(ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "no explicit step limit (%s)",
+                               std::string(integrator_names()[static_cast<int>(app.scene.settings.integration.integrator)]).c_str());
+        } else {
+            const double fraction = substep / limit.critical_substep;
+            const ImVec4 colour = fraction < 0.7   ? ImVec4(0.6f, 0.9f, 0.6f, 1.0f)
+                                  : fraction < 1.0 ? ImVec4(1.0f, 0.85f, 0.3f, 1.0f)
+                                                   : ImVec4(1.0f, 0.4f, 0.35f, 1.0f);
+            ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
+                        1e3 * limit.plane_wave_substep);
+            ImGui::TextColored(colour, "substep %.4g ms = %.2f of critical%s", 1e3 * substep, fraction,
+                               app.auto_substeps ? " (auto)" : (fraction >= 1.0 ? ": may blow up" : ""));
+        }
         fields_section(app, "integration.");
         fields_section(app, "solver.");
-        ImGui::Text("substep %.4g ms", 1000.0 * app.scene.settings.integration.dt / app.scene.settings.integration.substeps);
         ImGui::SliderInt("max catch-up steps", &app.max_catchup_steps, 1, 16);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
     }

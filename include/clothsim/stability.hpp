@@ -1,0 +1,49 @@
+// Stability limits known before stepping, and the guard that recovers when a step blows up anyway.
+//
+// Position Verlet on a linear spring network is stable iff every mode's w h < 2 sqrt(1 - d/2), with
+// d = c h / (1 + c h / 2) the per-step damping (docs/STABILITY.md derives it). The largest mode w_max is
+// bounded two ways:
+//  - Gershgorin: w_max^2 <= max_i sum_j 2 k_ij / m_i over particle i's springs. Always safe.
+//  - Plane waves on a regular grid: w_max^2 <= 4 (k_struct + k_shear + k_bend) / m. Tighter.
+// Symplectic Euler has Verlet's limit; RK4's stability region reaches w h = 2 sqrt(2) on the imaginary axis;
+// implicit Euler and XPBD have no explicit limit.
+#pragma once
+
+#include "clothsim/mass_spring.hpp"
+
+#include <string>
+
+namespace clothsim {
+
+struct StabilityLimit {
+    double omega_gershgorin = 0.0;  // rad/s, the safe bound on the fastest mode
+    double omega_plane_wave = 0.0;  // rad/s, the tighter grid bound
+    double critical_substep = 0.0;  // s: the largest stable substep by the Gershgorin bound (inf: none)
+    double plane_wave_substep = 0.0;  // s: the same with the plane-wave bound
+    bool unconditionally_stable = false;  // implicit Euler, XPBD
+};
+
+// For the cloth's current stiffness, masses, damping and integrator.
+StabilityLimit stability_limit(const MassSpring& sim);
+StabilityLimit stability_limit(const Topology& topology, const State& state, const SimulationSettings& settings);
+
+// Substeps per step that keep dt / substeps below `safety` x the critical substep (at least `minimum`,
+// at most 100000).
+int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minimum = 1);
+
+// What the guard checks after each step: every position finite, and no spring stretched beyond
+// `max_strain` (|d| / L0 - 1) — a cloth that far from rest has blown up even if it is still finite.
+struct GuardSettings {
+    float max_strain = 10.0f;  // 1000%
+    int max_retries = 6;       // each retry doubles the substeps
+};
+
+// Runs `steps` steps; when a step fails the check it rolls back to the state before that step, doubles
+// integration.substeps and retries. Each change is described in `log` (one line each). Returns false when
+// the retries ran out (the simulation is then left at the last good state, never NaN).
+bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log);
+
+// The largest |d| / L0 - 1 over springs with L0 > 0 (NaN-safe: a non-finite spring counts as infinite).
+double max_strain(const MassSpring& sim);
+
+}  // namespace clothsim

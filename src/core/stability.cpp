@@ -1,0 +1,119 @@
+#include "clothsim/stability.hpp"
+
+#include "forces.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace clothsim {
+namespace {
+
+// The largest h with w h < 2 sqrt(1 - d(h)/2), d(h) = c h / (1 + c h/2), found by bisection (the left
+// side grows with h, the right side shrinks). `factor` replaces 2 for RK4.
+double critical(double omega, double damping, double factor) {
+    if (!(omega > 0.0)) return std::numeric_limits<double>::infinity();
+    auto stable = [&](double h) {
+        const double d = damping * h / (1.0 + 0.5 * damping * h);
+        const double margin = 1.0 - 0.5 * d;
+        return margin > 0.0 && omega * h < factor * std::sqrt(margin);
+    };
+    double lo = 0.0, hi = factor / omega;  // undamped limit: the damped one is never larger
+    for (int i = 0; i < 100; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (stable(mid) ? lo : hi) = mid;
+    }
+    return lo;
+}
+
+}  // namespace
+
+StabilityLimit stability_limit(const Topology& topology, const State& state, const SimulationSettings& settings) {
+    StabilityLimit limit;
+    const Integrator integrator = settings.integration.integrator;
+    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Xpbd) {
+        limit.unconditionally_stable = true;
+        limit.critical_substep = limit.plane_wave_substep = std::numeric_limits<double>::infinity();
+        return limit;
+    }
+    std::vector<double> row_sum(state.size(), 0.0);
+    for (const Spring& s : topology.springs) {
+        const double k = stiffness_of(settings.springs, s.kind);
+        row_sum[s.a] += 2.0 * k;
+        row_sum[s.b] += 2.0 * k;
+    }
+    double gershgorin = 0.0, lightest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        if (state.pinned[i]) continue;
+        gershgorin = std::max(gershgorin, row_sum[i] / state.mass[i]);
+        lightest = std::min(lightest, static_cast<double>(state.mass[i]));
+    }
+    const SpringSettings& k = settings.springs;
+    const double sum_k = double(k.structural) + double(k.shear) + double(k.bending);
+    limit.omega_gershgorin = std::sqrt(gershgorin);
+    limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt(4.0 * sum_k / lightest) : 0.0;
+    const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
+    limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor);
+    limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor);
+    return limit;
+}
+
+StabilityLimit stability_limit(const MassSpring& sim) {
+    return stability_limit(sim.topology(), sim.state(), sim.settings());
+}
+
+int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minimum) {
+    if (!std::isfinite(limit.critical_substep) || !(limit.critical_substep > 0.0)) return std::max(minimum, 1);
+    const double wanted = std::ceil(double(dt) / (double(safety) * limit.critical_substep));
+    return static_cast<int>(std::clamp(wanted, double(std::max(minimum, 1)), 100000.0));
+}
+
+double max_strain(const MassSpring& sim) {
+    double worst = 0.0;
+    for (const Spring& s : sim.topology().springs) {
+        if (s.rest_length == 0.0f) continue;
+        const double length = glm::length(glm::dvec3(sim.position(s.b)) - glm::dvec3(sim.position(s.a)));
+        if (!std::isfinite(length)) return std::numeric_limits<double>::infinity();
+        worst = std::max(worst, length / s.rest_length - 1.0);
+    }
+    return worst;
+}
+
+bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
+    for (long long done = 0; done < steps; ++done) {
+        const MassSpring good = sim;  // the last good state
+        int retries = 0;
+        for (;;) {
+            sim.run_steps(1);
+            const bool finite = sim.all_finite();
+            const double strain = finite ? max_strain(sim) : std::numeric_limits<double>::infinity();
+            if (finite && strain <= guard.max_strain) break;
+            const int substeps = sim.settings().integration.substeps;
+            char line[256];
+            if (retries >= guard.max_retries || substeps >= 100000) {
+                std::snprintf(line, sizeof line,
+                              "guard: t = %.4g s: the step failed (%s) after %d retries; stopped at the last good "
+                              "state\n",
+                              good.time(), finite ? "strain beyond the bound" : "non-finite positions", retries);
+                log += line;
+                sim = good;
+                return false;
+            }
+            sim = good;
+            sim.settings().integration.substeps = std::min(2 * substeps, 100000);
+            std::snprintf(line, sizeof line,
+                          "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
+                          "from %d to %d\n",
+                          good.time(), finite ? "max strain above the bound" : "non-finite positions", substeps,
+                          sim.settings().integration.substeps);
+            log += line;
+            ++retries;
+        }
+    }
+    return true;
+}
+
+}  // namespace clothsim

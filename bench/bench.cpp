@@ -3,6 +3,7 @@
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
+#include "stability_sweep.hpp"
 #include "work_precision.hpp"
 
 #include "clothsim/normals.hpp"
@@ -101,12 +102,20 @@ int main(int argc, char** argv) {
     work_precision->add_option("--repeats", wp.repeats, "Timed repetitions (median)")->check(CLI::Range(1, 50));
     work_precision->add_option("--csv", wp.csv, "Write the sweep as CSV");
     work_precision->add_option("--plots", wp.plot_dir, "Write accuracy-SCENE.png here (needs --csv; gnuplot)");
+    bench::StabilityOptions st;
+    CLI::App* stability = app.add_subcommand(
+        "stability", "Largest stable substep by bisection against the predicted one (docs/STABILITY.md)");
+    stability->add_option("--T", st.duration, "Simulated seconds per trial (at least 200 substeps)")
+        ->check(CLI::PositiveNumber);
+    stability->add_option("--csv", st.csv, "Write the sweep as CSV");
+    stability->add_option("--plot", st.plot, "Write the measured-against-predicted PNG (needs --csv; gnuplot)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
     }
     if (*work_precision) return bench::run_work_precision(wp);
+    if (*stability) return bench::run_stability(st);
 
     std::vector<Row> rows;
     try {

@@ -93,6 +93,7 @@ private:
     void compute_forces(const State& state, Vec3Array& force) const;
     bool wind_active() const;
     void step_velocity_integrator(Integrator integrator, float h);
+    void limit_strain_and_speed(float h);
 
     Topology topology_;
     State state_;

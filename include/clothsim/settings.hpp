@@ -54,6 +54,7 @@ struct SpringSettings {
     float shear = 40.0f;        // N/m: both diagonals
     float bending = 10.0f;      // N/m: two apart along rows and columns
     float damping = 0.2f;       // 1/s: velocity damping rate c in x'' = a - c x'
+    float strain_limit = 0.0f;  // fraction: 0 = off; otherwise no spring ends a substep longer than (1 + it) L0
 };
 
 struct ForceSettings {
@@ -63,6 +64,7 @@ struct ForceSettings {
     float drag = 0.6f;                      // kg/m^3: 0.5 * air density * drag coefficient
     float gust_strength = 0.0f;             // fraction of the wind speed added and removed by gusts
     float gust_frequency = 0.5f;            // Hz: main gust frequency
+    float max_speed = 0.0f;                 // m/s: 0 = off; otherwise particle speeds are clamped to it
 };
 
 // Which particles are pinned: a named preset and/or explicit (row, col) pairs.

@@ -1,8 +1,9 @@
 // Stability limits known before stepping, and the guard that recovers when a step blows up anyway.
 //
-// Position Verlet on a linear spring network is stable iff every mode's w h < 2 sqrt(1 - d/2), with
-// d = c h / (1 + c h / 2) the per-step damping (docs/STABILITY.md derives it). The largest mode w_max is
-// bounded two ways:
+// Position Verlet on a linear spring network is stable iff every mode's w h < 2 sqrt(1 - d/2) in the seed's
+// form x' = x + (x - x_prev)(1 - d) + a h^2; in clothsim's central-difference form (a h^2 divided by
+// 1 + c h / 2, d = c h / (1 + c h / 2)) the damping cancels and the condition is exactly w h < 2
+// (docs/STABILITY.md derives both). The largest mode w_max is bounded two ways:
 //  - Gershgorin: w_max^2 <= max_i sum_j 2 k_ij / m_i over particle i's springs. Always safe.
 //  - Plane waves on a regular grid: w_max^2 <= 4 (k_struct + k_shear + k_bend) / m. Tighter.
 // Symplectic Euler has Verlet's limit; RK4's stability region reaches w h = 2 sqrt(2) on the imaginary axis;

@@ -86,7 +86,43 @@ void MassSpring::step() {
         integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
         collide_all(state_, settings_.colliders);
     }
+    if (settings_.springs.strain_limit > 0.0f || settings_.forces.max_speed > 0.0f) {
+        limit_strain_and_speed(h);
+        collide_all(state_, settings_.colliders);  // a correction must not leave a particle inside a collider
+    }
     state_.time += h;
+}
+
+// Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
+// moving in proportion to their inverse masses (one Gauss-Seidel pass, spring-list order). The correction
+// moves positions only, like a collision push: it adds no velocity. Then speeds above max_speed are scaled
+// down. Both change the model where they act: a limited spring is stiffer than k, a clamped particle loses
+// energy (docs/STABILITY.md).
+void MassSpring::limit_strain_and_speed(float h) {
+    const float limit = settings_.springs.strain_limit;
+    if (limit > 0.0f) {
+        for (const Spring& s : topology_.springs) {
+            if (s.rest_length == 0.0f) continue;
+            const float wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
+            if (wa + wb == 0.0f) continue;
+            const glm::vec3 d = state_.position.get(s.b) - state_.position.get(s.a);
+            const float length = glm::length(d);
+            const float longest = (1.0f + limit) * s.rest_length;
+            if (!(length > longest)) continue;
+            const glm::vec3 shorten = d * ((length - longest) / (length * (wa + wb)));
+            state_.position.add(s.a, wa * shorten);
+            state_.position.add(s.b, -wb * shorten);
+        }
+    }
+    const float max_speed = settings_.forces.max_speed;
+    if (max_speed > 0.0f) {
+        const float longest_step = max_speed * h;
+        for (std::size_t i = 0; i < state_.size(); ++i) {
+            const glm::vec3 m = state_.motion.get(i);
+            const float step = glm::length(m);
+            if (step > longest_step) state_.motion.set(i, m * (longest_step / step));
+        }
+    }
 }
 
 // One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.

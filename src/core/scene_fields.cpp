@@ -33,6 +33,7 @@ const std::array kFields = {
     FieldInfo{"springs.shear", "N/m", 0, 1e9, "stiffness of diagonal springs", [](Scene& s) -> FieldRef { return &s.settings.springs.shear; }},
     FieldInfo{"springs.bending", "N/m", 0, 1e9, "stiffness of springs two apart along rows and columns", [](Scene& s) -> FieldRef { return &s.settings.springs.bending; }},
     FieldInfo{"springs.damping", "1/s", 0, 1e4, "velocity damping rate c in x'' = a - c x' (independent of dt)", [](Scene& s) -> FieldRef { return &s.settings.springs.damping; }},
+    FieldInfo{"springs.strain_limit", "", 0, 10, "0 = off; else Provot's limit: no spring ends a substep longer than (1 + this) x its rest length (0.1 = 10%)", [](Scene& s) -> FieldRef { return &s.settings.springs.strain_limit; }},
 
     FieldInfo{"forces.gravity", "m/s^2", -1e5, 1e5, "gravitational acceleration", [](Scene& s) -> FieldRef { return &s.settings.forces.gravity; }},
     FieldInfo{"forces.wind", "m/s", -kBig, kBig, "air velocity", [](Scene& s) -> FieldRef { return &s.settings.forces.wind; }},
@@ -40,6 +41,7 @@ const std::array kFields = {
     FieldInfo{"forces.drag", "kg/m^3", 0, 1e3, "0.5 x air density x drag coefficient", [](Scene& s) -> FieldRef { return &s.settings.forces.drag; }},
     FieldInfo{"forces.gust_strength", "", 0, 1, "fraction of the wind speed gusts add and remove", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_strength; }},
     FieldInfo{"forces.gust_frequency", "Hz", 0, 100, "main gust frequency", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_frequency; }},
+    FieldInfo{"forces.max_speed", "m/s", 0, 1e4, "0 = off; else every particle's speed is clamped to this", [](Scene& s) -> FieldRef { return &s.settings.forces.max_speed; }},
 
     FieldInfo{"pins", "", 0, 0, "a preset name, a list of [row, col], or { preset = NAME, particles = [[row, col], ...] }", [](Scene& s) -> FieldRef { return &s.pins; }},
 

@@ -12,12 +12,17 @@
 namespace clothsim {
 namespace {
 
-// The largest h with w h < 2 sqrt(1 - d(h)/2), d(h) = c h / (1 + c h/2), found by bisection (the left
-// side grows with h, the right side shrinks). `factor` replaces 2 for RK4.
-double critical(double omega, double damping, double factor) {
+// The largest h with w h < factor sqrt(1 - d(h)/2) for the per-step damping d(h) (docs/STABILITY.md),
+// found by bisection: the left side grows with h, the right side does not.
+//  - position Verlet as clothsim writes it (a h^2 divided by 1 + c h/2): the damping terms cancel and the
+//    limit is w h < 2 exactly, so d = 0 here;
+//  - symplectic Euler with explicit damping: w h < 2 sqrt(1 - c h / 2), so d = c h;
+//  - RK4: w h < 2 sqrt(2) (its undamped limit on the imaginary axis; damping only widens it slightly).
+enum class DampingForm { None, Explicit };
+double critical(double omega, double damping, double factor, DampingForm form) {
     if (!(omega > 0.0)) return std::numeric_limits<double>::infinity();
     auto stable = [&](double h) {
-        const double d = damping * h / (1.0 + 0.5 * damping * h);
+        const double d = form == DampingForm::Explicit ? damping * h : 0.0;
         const double margin = 1.0 - 0.5 * d;
         return margin > 0.0 && omega * h < factor * std::sqrt(margin);
     };
@@ -56,8 +61,9 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     limit.omega_gershgorin = std::sqrt(gershgorin);
     limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt(4.0 * sum_k / lightest) : 0.0;
     const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
-    limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor);
-    limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor);
+    const DampingForm form = integrator == Integrator::SymplecticEuler ? DampingForm::Explicit : DampingForm::None;
+    limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);
+    limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor, form);
     return limit;
 }
 

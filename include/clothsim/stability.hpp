@@ -19,8 +19,9 @@ namespace clothsim {
 struct StabilityLimit {
     double omega_gershgorin = 0.0;  // rad/s, the safe bound on the fastest mode
     double omega_plane_wave = 0.0;  // rad/s, the tighter grid bound
-    double critical_substep = 0.0;  // s: the largest stable substep by the Gershgorin bound (inf: none)
+    double critical_substep = 0.0;  // s: the largest stable substep by the Gershgorin bound and wind (inf: none)
     double plane_wave_substep = 0.0;  // s: the same with the plane-wave bound
+    double wind_substep = 0.0;      // s: the explicit limit of the wind's drag, 1 / rate (inf without wind)
     bool unconditionally_stable = false;  // implicit Euler, XPBD
 };
 
@@ -34,9 +35,12 @@ int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minim
 
 // What the guard checks after each step: every position finite, and no spring stretched beyond
 // `max_strain` (|d| / L0 - 1) — a cloth that far from rest has blown up even if it is still finite.
+// ... and no jump of total energy by more than `max_energy_growth` x (|E| + 1 J) in one step: a blow-up
+// multiplies it by orders of magnitude, wind or a grab adds far less.
 struct GuardSettings {
-    float max_strain = 10.0f;  // 1000%
-    int max_retries = 6;       // each retry doubles the substeps
+    float max_strain = 10.0f;          // 1000%
+    float max_energy_growth = 100.0f;  // see above
+    int max_retries = 6;               // each retry doubles the substeps
 };
 
 // Runs `steps` steps; when a step fails the check it rolls back to the state before that step, doubles

@@ -32,7 +32,8 @@ constexpr SliderHint kHints[] = {
     {"springs.bending", 0.0f, 1e5f, true},    {"springs.damping", 0.0f, 100.0f, true},
     {"forces.drag", 0.0f, 10.0f, true},       {"cloth.mass", 0.001f, 100.0f, true},
     {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
-    {"integration.tolerance", 1e-10f, 1e-2f, true},
+    {"integration.tolerance", 1e-10f, 1e-2f, true}, {"springs.strain_limit", 0.0f, 1.0f, false},
+    {"forces.max_speed", 0.0f, 100.0f, false},
 };
 
 const SliderHint* hint_for(std::string_view name) {

@@ -95,9 +95,10 @@ void MassSpring::step() {
 
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
 // moving in proportion to their inverse masses (one Gauss-Seidel pass, spring-list order). The correction
-// moves positions only, like a collision push: it adds no velocity. Then speeds above max_speed are scaled
-// down. Both change the model where they act: a limited spring is stiffer than k, a clamped particle loses
-// energy (docs/STABILITY.md).
+// adds no velocity of its own (like a collision push), and the ends' motion apart along the spring is
+// removed, shared by inverse mass so momentum is kept: a spring held at its limit stops stretching instead
+// of storing speed it cannot use. Then any particle moving faster than max_speed is slowed to it, its
+// substep's displacement shortened with it. Both change the model where they act (docs/STABILITY.md).
 void MassSpring::limit_strain_and_speed(float h) {
     const float limit = settings_.springs.strain_limit;
     if (limit > 0.0f) {
@@ -112,6 +113,12 @@ void MassSpring::limit_strain_and_speed(float h) {
             const glm::vec3 shorten = d * ((length - longest) / (length * (wa + wb)));
             state_.position.add(s.a, wa * shorten);
             state_.position.add(s.b, -wb * shorten);
+            const glm::vec3 n = d / length;
+            const float apart = glm::dot(state_.motion.get(s.b) - state_.motion.get(s.a), n);
+            if (apart > 0.0f) {
+                state_.motion.add(s.a, (wa / (wa + wb)) * apart * n);
+                state_.motion.add(s.b, -(wb / (wa + wb)) * apart * n);
+            }
         }
     }
     const float max_speed = settings_.forces.max_speed;
@@ -120,7 +127,10 @@ void MassSpring::limit_strain_and_speed(float h) {
         for (std::size_t i = 0; i < state_.size(); ++i) {
             const glm::vec3 m = state_.motion.get(i);
             const float step = glm::length(m);
-            if (step > longest_step) state_.motion.set(i, m * (longest_step / step));
+            if (!(step > longest_step)) continue;
+            const glm::vec3 clamped = m * (longest_step / step);
+            state_.position.add(i, clamped - m);  // the substep moved the particle by m: move it by clamped
+            state_.motion.set(i, clamped);
         }
     }
 }

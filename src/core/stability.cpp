@@ -64,6 +64,25 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const DampingForm form = integrator == Integrator::SymplecticEuler ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);
     limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor, form);
+    // Wind pressure on a particle's share of the area is a drag, F ~ drag A |w_rel| w_rel, whose rate
+    // 2 drag A |w_rel| / m an explicit step must keep below about 1 per substep (forward Euler's limit on
+    // a decay rate is 2; half of it leaves room for the gusts and for the cloth's own speed).
+    limit.wind_substep = std::numeric_limits<double>::infinity();
+    const ForceSettings& f = settings.forces;
+    const double wind_speed = glm::length(glm::dvec3(f.wind)) * (1.0 + f.gust_strength);
+    if (wind_speed > 0.0 && f.drag > 0.0f && std::isfinite(lightest) && state.size() > 0) {
+        double area = 0.0;
+        for (const auto& t : topology.triangles) {
+            const glm::vec3 a = state.position.get(t[0]);
+            area += 0.5 * glm::length(glm::cross(state.position.get(t[1]) - a, state.position.get(t[2]) - a));
+        }
+        const double share = f.wind_model == WindModel::Uniform ? area / double(state.size())
+                                                                 : 6.0 * area / (3.0 * double(state.size()));
+        const double rate = 2.0 * f.drag * share * wind_speed / lightest;
+        if (rate > 0.0) limit.wind_substep = 1.0 / rate;
+    }
+    limit.critical_substep = std::min(limit.critical_substep, limit.wind_substep);
+    limit.plane_wave_substep = std::min(limit.plane_wave_substep, limit.wind_substep);
     return limit;
 }
 
@@ -91,19 +110,26 @@ double max_strain(const MassSpring& sim) {
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
     for (long long done = 0; done < steps; ++done) {
         const MassSpring good = sim;  // the last good state
+        const double energy_before = good.energy().total();
         int retries = 0;
         for (;;) {
             sim.run_steps(1);
             const bool finite = sim.all_finite();
             const double strain = finite ? max_strain(sim) : std::numeric_limits<double>::infinity();
-            if (finite && strain <= guard.max_strain) break;
+            const double energy = finite ? sim.energy().total() : std::numeric_limits<double>::infinity();
+            const bool energy_ok =
+                std::isfinite(energy) &&
+                energy - energy_before <= guard.max_energy_growth * (std::fabs(energy_before) + 1.0);
+            if (finite && strain <= guard.max_strain && energy_ok) break;
             const int substeps = sim.settings().integration.substeps;
             char line[256];
             if (retries >= guard.max_retries || substeps >= 100000) {
                 std::snprintf(line, sizeof line,
                               "guard: t = %.4g s: the step failed (%s) after %d retries; stopped at the last good "
                               "state\n",
-                              good.time(), finite ? "strain beyond the bound" : "non-finite positions", retries);
+                              good.time(),
+                              !finite ? "non-finite positions" : (energy_ok ? "strain beyond the bound" : "energy blew up"),
+                              retries);
                 log += line;
                 sim = good;
                 return false;
@@ -113,7 +139,9 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
             std::snprintf(line, sizeof line,
                           "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
                           "from %d to %d\n",
-                          good.time(), finite ? "max strain above the bound" : "non-finite positions", substeps,
+                          good.time(),
+                          !finite ? "non-finite positions" : (energy_ok ? "max strain above the bound" : "energy blew up"),
+                          substeps,
                           sim.settings().integration.substeps);
             log += line;
             ++retries;

@@ -1,5 +1,7 @@
 #include "stability_sweep.hpp"
 
+#include "csv.hpp"
+
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
@@ -80,14 +82,11 @@ int run_stability(const StabilityOptions& options) {
         for (int n : {4, 8, 32}) cases.push_back({"grid", integrator, 1e3f, 0.5f, 0.2f, n});
     }
     std::ofstream csv;
-    if (!options.csv.empty()) {
-        csv.open(options.csv);
-        if (!csv) {
-            std::cerr << "clothsim-bench: error: cannot write " << options.csv << "\n";
-            return 2;
-        }
-        csv << "sweep,integrator,stiffness,mass,damping,grid,predicted_gershgorin,predicted_plane_wave,measured,"
-               "measured_over_predicted,safe\n";
+    if (!open_csv(options.csv,
+                  "sweep,integrator,stiffness,mass,damping,grid,predicted_gershgorin,predicted_plane_wave,measured,"
+                  "measured_over_predicted,safe",
+                  csv)) {
+        return 2;
     }
     std::printf("%-9s %-17s %9s %6s %7s %4s %12s %12s %12s %8s %5s\n", "sweep", "integrator", "k (N/m)", "mass",
                 "damping", "grid", "predicted", "plane wave", "measured", "ratio", "safe");

@@ -1,5 +1,7 @@
 #include "work_precision.hpp"
 
+#include "csv.hpp"
+
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
 
@@ -93,14 +95,11 @@ Run run(const Scene& base, Integrator integrator, double h, double duration, int
 
 int run_work_precision(const WorkPrecisionOptions& options) {
     std::ofstream csv;
-    if (!options.csv.empty()) {
-        csv.open(options.csv);
-        if (!csv) {
-            std::cerr << "clothsim-bench: error: cannot write " << options.csv << "\n";
-            return 2;
-        }
-        csv << "scene,integrator,substep,steps,finite,wall_seconds,seconds_per_simulated_second,error_max,error_rms,"
-               "energy_error,reference_substep,reference_halving_change\n";
+    if (!open_csv(options.csv,
+                  "scene,integrator,substep,steps,finite,wall_seconds,seconds_per_simulated_second,error_max,"
+                  "error_rms,energy_error,reference_substep,reference_halving_change",
+                  csv)) {
+        return 2;
     }
     for (const std::string& scene_name : options.scenes) {
         Scene scene;

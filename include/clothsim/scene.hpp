@@ -53,6 +53,12 @@ std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook
 std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd
 
+// The names of an enumeration field's values, by the field's type (the loader, the field table and the
+// panel treat every enumeration alike through these).
+inline std::span<const std::string_view> names_of(const WindModel*) { return wind_model_names(); }
+inline std::span<const std::string_view> names_of(const SolverMethod*) { return solver_method_names(); }
+inline std::span<const std::string_view> names_of(const Integrator*) { return integrator_names(); }
+
 // ---- Loading and overriding. All throw SceneError; on a throw the target scene is left unchanged. ----
 Scene parse_scene(std::string_view toml_text, std::string_view source_name);
 Scene load_scene_file(const std::filesystem::path& path);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <type_traits>
 #include <variant>
 
 namespace clothsim {
@@ -146,9 +147,7 @@ bool field_widget(AppState& app, const FieldInfo& f) {
                 }
                 return edited;
             },
-            [&](SolverMethod* v) { return enum_combo(label.c_str(), v, solver_method_names()); },
-            [&](WindModel* v) { return enum_combo(label.c_str(), v, wind_model_names()); },
-            [&](Integrator* v) { return enum_combo(label.c_str(), v, integrator_names()); },
+            [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return enum_combo(label.c_str(), v, names_of(v)); },
         },
         f.ref(app.scene));
     tooltip(f);

@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cstdio>
 #include <sstream>
+#include <type_traits>
 
 namespace clothsim {
 namespace {
@@ -133,9 +134,7 @@ std::string describe_allowed(const FieldInfo& field) {
             [&](glm::vec3*) { return cat("[x, y, z], each in ", range(field), unit); },
             [&](std::string*) { return std::string("a string"); },
             [&](PinSpec*) { return "one of " + join(kPinPresetNames) + ", a list of [row, col], or a table with preset and particles"; },
-            [&](WindModel*) { return "one of " + join(kWindModelNames); },
-            [&](SolverMethod*) { return "one of " + join(kSolverMethodNames); },
-            [&](Integrator*) { return "one of " + join(kIntegratorNames); },
+            [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return "one of " + join(names_of(v)); },
         },
         field.ref(scratch));
 }
@@ -178,9 +177,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
                 }
                 return cat("{ preset = ", preset, ", particles = [", list, "] }");
             },
-            [&](WindModel* v) { return quoted(kWindModelNames[static_cast<int>(*v)]); },
-            [&](SolverMethod* v) { return quoted(kSolverMethodNames[static_cast<int>(*v)]); },
-            [&](Integrator* v) { return quoted(kIntegratorNames[static_cast<int>(*v)]); },
+            [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
         },
         field.ref(s));
 }

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 #include <utility>
 
 #ifndef CLOTHSIM_DEFAULT_SCENE_DIR
@@ -160,20 +161,8 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
                 *target = *v;
                 return true;
             },
-            [&](WindModel* target) {
-                const auto v = enum_of<WindModel>(node, wind_model_names());
-                if (!v) return false;
-                *target = *v;
-                return true;
-            },
-            [&](SolverMethod* target) {
-                const auto v = enum_of<SolverMethod>(node, solver_method_names());
-                if (!v) return false;
-                *target = *v;
-                return true;
-            },
-            [&](Integrator* target) {
-                const auto v = enum_of<Integrator>(node, integrator_names());
+            [&]<class Enum>(Enum* target) requires std::is_enum_v<Enum> {
+                const auto v = enum_of<Enum>(node, names_of(target));
                 if (!v) return false;
                 *target = *v;
                 return true;

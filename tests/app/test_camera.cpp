@@ -2,6 +2,8 @@
 // gestures (orbit, pan, zoom) and framing, checked against geometry worked out independently of the code.
 #include "camera.hpp"
 
+#include "vec_checks.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <glm/geometric.hpp>
@@ -21,16 +23,8 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-std::string str(glm::vec3 v) {
-    std::ostringstream s;
-    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-    return s.str();
-}
-
-void check_near(glm::vec3 actual, glm::vec3 expected, float tolerance) {
-    INFO("actual " << str(actual) << ", expected " << str(expected) << ", tolerance " << tolerance);
-    CHECK(glm::length(actual - expected) <= tolerance);
-}
+using clothsim::test::check_near;
+using clothsim::test::str;
 
 glm::vec3 transform_point(const glm::mat4& m, glm::vec3 p) {
     const glm::vec4 h = m * glm::vec4(p, 1.0f);

@@ -4,6 +4,8 @@
 #include "layout.hpp"
 #include "picking.hpp"
 
+#include "vec_checks.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <glm/geometric.hpp>
@@ -20,16 +22,8 @@ using namespace clothsim;
 
 namespace {
 
-std::string str(glm::vec3 v) {
-    std::ostringstream s;
-    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-    return s.str();
-}
-
-void check_near(glm::vec3 actual, glm::vec3 expected, float tolerance) {
-    INFO("actual " << str(actual) << ", expected " << str(expected) << ", tolerance " << tolerance);
-    CHECK(glm::length(actual - expected) <= tolerance);
-}
+using clothsim::test::check_near;
+using clothsim::test::str;
 
 std::vector<OrbitCamera> sample_cameras() {
     std::vector<OrbitCamera> cameras;

@@ -103,7 +103,7 @@ struct ColliderSettings {
 
 struct IntegrationSettings {
     float dt = 1.0f / 60.0f;  // s: one step (one frame of the app)
-    int substeps = 25;        // integration substeps per step; each advances dt / substeps
+    int substeps = 34;        // integration substeps per step; each advances dt / substeps
     Integrator integrator = Integrator::Verlet;
     float tolerance = 1e-5f;  // implicit Euler: CG stops at this residual relative to the right-hand side
 };

@@ -106,7 +106,7 @@ TEST_CASE("scene: a bundled scene loads the values written in its file") {
     CHECK(s.pins.particles.empty());
     CHECK(s.settings.forces.wind.x == 8.0f);
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Triangles);
-    CHECK(s.settings.integration.substeps == 25);
+    CHECK(s.settings.integration.substeps == 40);
     // A field a file leaves out keeps its default.
     CHECK(s.settings.colliders.thickness == clothsim::ColliderSettings{}.thickness);
 }

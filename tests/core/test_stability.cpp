@@ -881,3 +881,14 @@ TEST_CASE("stability grids beyond kMaxParticles are rejected with the limit in t
     edge.cloth.rows = 1025;
     CHECK_THROWS_AS(validate(edge), SceneError);
 }
+
+TEST_CASE("stability every bundled scene steps inside its predicted limit", "[stability]") {
+    // The scenes' substeps are chosen so the substep is at most 0.7 of the Gershgorin critical substep:
+    // safe by the bound, not only in practice (the panel shows it green).
+    for (const std::string& name : bundled_scene_names()) {
+        const MassSpring sim = build_simulation(load_scene(name));
+        const StabilityLimit limit = stability_limit(sim);
+        INFO(name << ": substep " << sim.substep_length() << " s, critical " << limit.critical_substep << " s");
+        CHECK(sim.substep_length() <= 0.7 * limit.critical_substep);
+    }
+}

@@ -183,7 +183,12 @@ bool field_widget(AppState& app, const FieldInfo& f) {
 bool fields_section(AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
-        if (f.name.starts_with(prefix)) changed |= field_widget(app, f);
+        if (!f.name.starts_with(prefix)) continue;
+        // Auto substeps owns the substeps field; greyed out so an edit is not silently overwritten.
+        const bool owned = app.auto_substeps && f.name == "integration.substeps";
+        if (owned) ImGui::BeginDisabled();
+        changed |= field_widget(app, f);
+        if (owned) ImGui::EndDisabled();
     }
     return changed;
 }

@@ -101,6 +101,8 @@ struct ColliderSettings {
     float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
 };
 
+inline constexpr int kMaxSubsteps = 10000;  // the largest integration.substeps a scene may hold
+
 struct IntegrationSettings {
     float dt = 1.0f / 60.0f;  // s: one step (one frame of the app)
     int substeps = 34;        // integration substeps per step; each advances dt / substeps

@@ -6,8 +6,9 @@
 // (docs/STABILITY.md derives both). The largest mode w_max is bounded two ways:
 //  - Gershgorin: w_max^2 <= max_i sum_j 2 k_ij / m_i over particle i's springs. Always safe.
 //  - Plane waves on a regular grid: w_max^2 <= 4 (k_struct + k_shear + k_bend) / m. Tighter.
-// Symplectic Euler has Verlet's limit; RK4's stability region reaches w h = 2 sqrt(2) on the imaginary axis;
-// implicit Euler and XPBD have no explicit limit.
+// Symplectic Euler has Verlet's limit; RK4's stability region reaches w h = 2 sqrt(2) on the imaginary axis
+// (and c h = 2.785 for damping); implicit Euler has no limit; XPBD's only one is its explicitly damped
+// prediction, c h < 2.
 #pragma once
 
 #include "clothsim/mass_spring.hpp"
@@ -30,7 +31,7 @@ StabilityLimit stability_limit(const MassSpring& sim);
 StabilityLimit stability_limit(const Topology& topology, const State& state, const SimulationSettings& settings);
 
 // Substeps per step that keep dt / substeps below `safety` x the critical substep (at least `minimum`,
-// at most 100000).
+// at most kMaxSubsteps, the largest a scene may hold).
 int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minimum = 1);
 
 // What the guard checks after each step: every position finite, and no spring stretched beyond

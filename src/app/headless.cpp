@@ -124,7 +124,7 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
         std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(),
                     sim.spring_count());
         std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", done, dt,
-                    scene.settings.integration.substeps, sim.time(), wall);
+                    sim.settings().integration.substeps, sim.time(), wall);
         std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
                     e.total(), finite ? "yes" : "no");
     }

@@ -165,14 +165,17 @@ void GridSolver::step(State& state, const SimulationSettings& settings, const Ve
     auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
     if (blocks == 1) {
         sweep(state, settings, external, h, 0, rows_, scratch_[0]);
+        state.substep = h;
         return;
     }
 #pragma omp parallel num_threads(blocks)
     {
-        const int b = omp_get_thread_num();
+        // OpenMP may give fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, nesting): every thread
+        // takes every team-size-th block, so no block is ever skipped and each is computed the same way.
+        const int team = omp_get_num_threads();
         // Phase 1: the two spring rows above the next block read that block's first rows, which its thread
         // will overwrite; compute them while every position is still the old one.
-        if (b + 1 < blocks) {
+        for (int b = omp_get_thread_num(); b + 1 < blocks; b += team) {
             const int next = block_begin(b + 1);
             for (int r : {next - 2, next - 1}) {
                 spring_row(state, settings.springs, r,
@@ -180,8 +183,11 @@ void GridSolver::step(State& state, const SimulationSettings& settings, const Ve
             }
         }
 #pragma omp barrier
-        sweep(state, settings, external, h, block_begin(b), block_begin(b + 1), scratch_[b]);
+        for (int b = omp_get_thread_num(); b < blocks; b += team) {
+            sweep(state, settings, external, h, block_begin(b), block_begin(b + 1), scratch_[b]);
+        }
     }
+    state.substep = h;
 }
 
 // ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----
@@ -332,7 +338,6 @@ void GridSolver::sweep(State& state, const SimulationSettings& settings, const V
     const Grid grid{rows_, cols_, rest_};
     (kAvx2 ? sweep_avx2 : sweep_generic)(grid, boundary_, boundary_slot_, state, settings, external, h, begin, end,
                                          scratch.window.data(), zeros_.data());
-    state.substep = h;
 }
 
 }  // namespace clothsim

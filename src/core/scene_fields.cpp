@@ -60,7 +60,7 @@ const std::array kFields = {
     FieldInfo{"colliders.thickness", "m", 0, 1, "distance particles keep from every collider surface", [](Scene& s) -> FieldRef { return &s.settings.colliders.thickness; }},
 
     FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
-    FieldInfo{"integration.substeps", "", 1, 10000, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
+    FieldInfo{"integration.substeps", "", 1, kMaxSubsteps, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
     FieldInfo{"integration.integrator", "", 0, 0, "time integrator (orders: verlet 2, symplectic-euler 1, rk4 4, implicit-euler 1; xpbd tends to the spring model as substeps grow)", [](Scene& s) -> FieldRef { return &s.settings.integration.integrator; }},
     FieldInfo{"integration.tolerance", "", 1e-12, 0.1, "implicit-euler: conjugate-gradient residual relative to the right-hand side", [](Scene& s) -> FieldRef { return &s.settings.integration.tolerance; }},
 

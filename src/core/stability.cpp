@@ -39,9 +39,20 @@ double critical(double omega, double damping, double factor, DampingForm form) {
 StabilityLimit stability_limit(const Topology& topology, const State& state, const SimulationSettings& settings) {
     StabilityLimit limit;
     const Integrator integrator = settings.integration.integrator;
-    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Xpbd) {
+    const double c = settings.springs.damping;
+    if (integrator == Integrator::ImplicitEuler) {
         limit.unconditionally_stable = true;
-        limit.critical_substep = limit.plane_wave_substep = std::numeric_limits<double>::infinity();
+        limit.critical_substep = limit.plane_wave_substep = limit.wind_substep = std::numeric_limits<double>::infinity();
+        return limit;
+    }
+    if (integrator == Integrator::Xpbd) {
+        // Springs are projected implicitly; the damping in XPBD's explicit prediction is forward Euler on a
+        // decay rate c, stable while c h < 2.
+        limit.unconditionally_stable = !(c > 0.0);
+        limit.critical_substep = limit.plane_wave_substep = limit.unconditionally_stable
+                                                                ? std::numeric_limits<double>::infinity()
+                                                                : 2.0 / c;
+        limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
     std::vector<double> row_sum(state.size(), 0.0);
@@ -83,6 +94,11 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     }
     limit.critical_substep = std::min(limit.critical_substep, limit.wind_substep);
     limit.plane_wave_substep = std::min(limit.plane_wave_substep, limit.wind_substep);
+    if (integrator == Integrator::Rk4 && c > 0.0) {
+        // RK4 on a pure decay rate c is stable while c h < 2.785 (its stability region on the real axis).
+        limit.critical_substep = std::min(limit.critical_substep, 2.785 / c);
+        limit.plane_wave_substep = std::min(limit.plane_wave_substep, 2.785 / c);
+    }
     return limit;
 }
 
@@ -93,7 +109,7 @@ StabilityLimit stability_limit(const MassSpring& sim) {
 int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minimum) {
     if (!std::isfinite(limit.critical_substep) || !(limit.critical_substep > 0.0)) return std::max(minimum, 1);
     const double wanted = std::ceil(double(dt) / (double(safety) * limit.critical_substep));
-    return static_cast<int>(std::clamp(wanted, double(std::max(minimum, 1)), 100000.0));
+    return static_cast<int>(std::clamp(wanted, double(std::max(minimum, 1)), double(kMaxSubsteps)));
 }
 
 double max_strain(const MassSpring& sim) {
@@ -123,7 +139,7 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
             if (finite && strain <= guard.max_strain && energy_ok) break;
             const int substeps = sim.settings().integration.substeps;
             char line[256];
-            if (retries >= guard.max_retries || substeps >= 100000) {
+            if (retries >= guard.max_retries || substeps >= kMaxSubsteps) {
                 std::snprintf(line, sizeof line,
                               "guard: t = %.4g s: the step failed (%s) after %d retries; stopped at the last good "
                               "state\n",
@@ -135,7 +151,7 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
                 return false;
             }
             sim = good;
-            sim.settings().integration.substeps = std::min(2 * substeps, 100000);
+            sim.settings().integration.substeps = std::min(2 * substeps, kMaxSubsteps);
             std::snprintf(line, sizeof line,
                           "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
                           "from %d to %d\n",

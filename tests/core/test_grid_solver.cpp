@@ -136,3 +136,21 @@ TEST_CASE("grid_solver is only used for grid topologies; others run the textbook
     CHECK(sim.position(0).x > 0.0f);
     CHECK(sim.position(1).x == 1.0f);
 }
+
+TEST_CASE("grid_solver steps every row block when OpenMP gives fewer threads than blocks", "[grid_solver]") {
+    // Inside an active parallel region (nested parallelism off by default) the solver's own region gets a
+    // team of one thread: every block must still be stepped, and bit-identically.
+    Scene scene = load_scene("hanging");
+    scene.cloth.rows = 64;
+    const MassSpring one = run(scene, SolverMethod::Fast, 1, 100);
+    scene.settings.solver.method = SolverMethod::Fast;
+    scene.settings.solver.threads = 4;
+    MassSpring nested = build_simulation(scene);
+#pragma omp parallel num_threads(2)
+    {
+#pragma omp single
+        for (int i = 0; i < 100; ++i) nested.step();
+    }
+    CHECK(nested.solver_threads() == 4);
+    CHECK(bit_identical(one, nested));
+}

@@ -322,10 +322,10 @@ TEST_CASE("stability auto_substeps keeps dt / substeps below safety x critical a
     none.critical_substep = std::numeric_limits<double>::infinity();
     CHECK(auto_substeps(none, dt, 0.9f, 0) == 1);
     CHECK(auto_substeps(none, dt, 0.9f, 4) == 4);
-    // At most 100000.
+    // At most kMaxSubsteps, the largest a scene file may hold (so what is chosen can be saved and loaded).
     StabilityLimit tiny;
     tiny.critical_substep = 1e-12;
-    CHECK(auto_substeps(tiny, dt, 0.9f, 1) == 100000);
+    CHECK(auto_substeps(tiny, dt, 0.9f, 1) == kMaxSubsteps);
 }
 
 // ---- 4. run_guarded. ----
@@ -891,4 +891,40 @@ TEST_CASE("stability every bundled scene steps inside its predicted limit", "[st
         INFO(name << ": substep " << sim.substep_length() << " s, critical " << limit.critical_substep << " s");
         CHECK(sim.substep_length() <= 0.7 * limit.critical_substep);
     }
+}
+
+TEST_CASE("stability damping limits the explicit parts of XPBD and RK4, and auto substeps respects it", "[stability]") {
+    for (auto [integrator, damping] : {std::pair{Integrator::Xpbd, 3000.0f}, std::pair{Integrator::Rk4, 9000.0f}}) {
+        Scene s = load_scene("hanging");
+        s.cloth.rows = s.cloth.cols = 12;
+        s.settings.integration.integrator = integrator;
+        s.settings.springs.damping = damping;
+        MassSpring sim = build_simulation(s);
+        const StabilityLimit limit = stability_limit(sim);
+        INFO("integrator " << int(integrator) << ", damping " << damping << ": critical " << limit.critical_substep);
+        CHECK_FALSE(limit.unconditionally_stable);
+        CHECK(limit.critical_substep * damping <= 2.785 + 1e-9);
+        sim.settings().integration.substeps = auto_substeps(limit, s.settings.integration.dt, 0.5f);
+        sim.run_steps(20);
+        CHECK(sim.all_finite());
+        CHECK(std::isfinite(sim.energy().total()));
+        CHECK(sim.energy().total() < 100.0);
+    }
+}
+
+TEST_CASE("stability the guard never raises substeps beyond what a scene file may hold", "[stability]") {
+    Scene s = load_scene("hanging");
+    s.cloth.rows = s.cloth.cols = 4;
+    s.settings.springs.structural = 1e9f;
+    s.cloth.mass = 0.005f;
+    s.settings.integration.substeps = 8000;
+    MassSpring sim = build_simulation(s);
+    std::string log;
+    run_guarded(sim, 2, GuardSettings{}, log);
+    INFO(log);
+    CHECK(sim.settings().integration.substeps <= kMaxSubsteps);
+    CHECK(sim.all_finite());
+    Scene saved = s;
+    saved.settings.integration.substeps = sim.settings().integration.substeps;
+    CHECK_NOTHROW(parse_scene(to_toml(saved), "saved.toml"));  // what "Save scene as" writes loads back
 }

@@ -151,7 +151,7 @@ Ray cursor_ray(const AppState& app, const Window& window, float scale) {
 
 // Converts the pins of the running simulation to the scene's explicit list, so "Save scene" keeps them.
 void pins_to_scene(AppState& app) {
-    const int cols = app.scene.cloth.cols;
+    const int cols = app.sim.topology().cols;  // the running cloth, even if an edit of the grid failed to rebuild
     app.scene.pins.preset = PinPreset::None;
     app.scene.pins.particles.clear();
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {

@@ -3,7 +3,22 @@
 
 #include "clothsim/scene.hpp"
 
+#include <initializer_list>
+
 namespace clothsim::test {
+
+// Free particles of one mass at the given positions, at rest: every state array sized, nothing pinned.
+inline State free_particles(std::initializer_list<glm::vec3> positions, float mass) {
+    State st;
+    st.position.resize(positions.size());
+    st.motion.resize(positions.size());
+    std::size_t i = 0;
+    for (const glm::vec3& p : positions) st.position.set(i++, p);
+    st.mass.assign(positions.size(), mass);
+    st.inverse_mass.assign(positions.size(), 1.0f / mass);
+    st.pinned.assign(positions.size(), 0);
+    return st;
+}
 
 // A vertical chain of `particles` particles spaced `spacing` apart hanging down from the origin, with only
 // structural springs of stiffness k, no gravity, no damping, no colliders, nothing pinned.

@@ -1,5 +1,6 @@
 // Force stages: Hooke's law, wind pressure on triangles (edge-on: none), gusts.
 #include "forces.hpp"
+#include "support.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -11,14 +12,7 @@ using namespace clothsim;
 namespace {
 
 State two_particles(glm::vec3 a, glm::vec3 b) {
-    State st;
-    st.position.resize(2);
-    st.motion.resize(2);
-    st.position.set(0, a);
-    st.position.set(1, b);
-    st.mass.assign(2, 1.0f);
-    st.inverse_mass.assign(2, 1.0f);
-    st.pinned.assign(2, 0);
+    State st = test::free_particles({a, b}, 1.0f);
     st.substep = 0.01f;
     return st;
 }
@@ -33,14 +27,7 @@ Topology one_triangle() {
 }
 
 State triangle_state() {
-    State st;
-    st.position.resize(3);
-    st.motion.resize(3);
-    st.position.set(1, {1.0f, 0.0f, 0.0f});
-    st.position.set(2, {0.0f, 1.0f, 0.0f});
-    st.mass.assign(3, 1.0f);
-    st.inverse_mass.assign(3, 1.0f);
-    st.pinned.assign(3, 0);
+    State st = test::free_particles({{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}}, 1.0f);
     st.substep = 0.01f;
     return st;
 }

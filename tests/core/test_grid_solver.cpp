@@ -116,13 +116,7 @@ TEST_CASE("grid_solver is only used for grid topologies; others run the textbook
                  {0, 2, 2.0f, SpringKind::Bending}};  // either end may come first
     CHECK(GridSolver::for_topology(t).has_value());
 
-    State st;
-    st.position.resize(3);
-    st.position.set(1, {1.0f, 0.0f, 0.0f});
-    st.position.set(2, {2.5f, 0.0f, 0.0f});
-    st.mass.assign(3, 1.0f);
-    st.inverse_mass.assign(3, 1.0f);
-    st.pinned.assign(3, 0);
+    const State st = test::free_particles({{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {2.5f, 0.0f, 0.0f}}, 1.0f);
     Topology odd;
     odd.rows = 1;
     odd.cols = 3;

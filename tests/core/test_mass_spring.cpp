@@ -117,14 +117,7 @@ TEST_CASE("mass_spring zero-length springs and coincident particles stay finite"
     t.cols = 3;
     t.springs = {{0, 1, 0.0f, SpringKind::Structural},   // zero rest length: F = k d, fine at d = 0
                  {1, 2, 0.5f, SpringKind::Structural}};  // rest 0.5 but the ends coincide: no direction
-    State st;
-    st.position.resize(3);
-    st.position.set(0, {0.0f, 0.0f, 0.0f});
-    st.position.set(1, {0.0f, 0.0f, 0.0f});
-    st.position.set(2, {0.0f, 0.0f, 0.0f});
-    st.mass.assign(3, 1.0f);
-    st.inverse_mass.assign(3, 1.0f);
-    st.pinned.assign(3, 0);
+    const State st = test::free_particles({glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)}, 1.0f);
     SimulationSettings settings;
     settings.forces.gravity = glm::vec3(0.0f);
     settings.colliders.ground.enabled = false;

@@ -688,15 +688,9 @@ TEST_CASE("stability coincident particles from a 0.001 m cloth run finite", "[st
 TEST_CASE("stability a hand-built topology with zero-length springs runs finite", "[stability]") {
     // Three particles at one point: a spring of rest length 0 (pulls toward coincidence) and one of rest
     // length 0.1 m that starts at length 0 (no direction to push along), plus a normal spring.
-    State state;
-    state.position.resize(4);
-    state.position.set(0, {0.0f, 1.0f, 0.0f});
-    state.position.set(1, {0.0f, 1.0f, 0.0f});
-    state.position.set(2, {0.0f, 1.0f, 0.0f});
-    state.position.set(3, {0.2f, 1.0f, 0.0f});
-    state.mass.assign(4, 0.01f);
-    state.inverse_mass.assign(4, 100.0f);
-    state.pinned.assign(4, 0);
+    const State state = test::free_particles({{0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f},
+                                              {0.2f, 1.0f, 0.0f}},
+                                             0.01f);
     Topology topology;
     topology.springs = {{0, 1, 0.0f, SpringKind::Structural},
                         {1, 2, 0.1f, SpringKind::Structural},

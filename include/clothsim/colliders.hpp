@@ -9,10 +9,14 @@
 // back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
 #pragma once
 
+#include "clothsim/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
+#include "clothsim/step_profile.hpp"
 
 #include <glm/vec3.hpp>
+
+#include <vector>
 
 namespace clothsim {
 
@@ -29,10 +33,25 @@ void collide(State& state, const CubeCollider& cube, float thickness, std::size_
              std::size_t end = kAllParticles);
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
-// Every enabled collider, in the order sphere, cube, ground. For float (the simulation) and double (the
-// reference solution).
+// Every enabled collider, in the order sphere, cube, ground, testing every particle. For float and double
+// (the reference solution).
 template <class T>
 void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
+
+// The particles as consecutive blocks of `size` (the last may be shorter) and each block's box.
+struct CollisionBlocks {
+    std::size_t size = kBlockParticles;
+    std::vector<Box> boxes;
+    bool current = false;  // the boxes bound the particles as they are now
+};
+
+// The collision stage of a substep: the same contacts as collide_all, in the same order, but with
+// `broad_phase` a collider is tested particle by particle only on the blocks whose box may touch it
+// (broad_phase.hpp). The boxes are computed here unless blocks.current, and a block's box is recomputed
+// after a collider pushes one of its particles, so the next collider sees where the particles are now.
+// Each collider's time and block counts go to `profile` when it is not null.
+void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
+                   StepProfile* profile);
 
 }  // namespace clothsim

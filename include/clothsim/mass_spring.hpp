@@ -2,17 +2,29 @@
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,
-// ground). Topology is fixed at construction; SimulationSettings may be edited between steps (stiffness,
-// damping, forces, colliders, dt, substeps) and take effect at the next step.
+// ground), limit strain and speed, and once per step see whether the cloth may sleep. Which of these stages
+// run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
+// Topology is fixed at construction; SimulationSettings may be edited between steps (stiffness, damping,
+// forces, colliders, dt, substeps) and take effect at the next step.
+//
+// Sleeping (as Box2D's islands sleep): when solver.sleep_speed > 0, the air is still, and at the end of
+// every step for solver.sleep_time seconds each free particle moved less than sleep_speed x substep in the
+// substep, the cloth falls asleep: its motion is set to zero and substeps only advance the clock. Any
+// change of the settings (a collider moved, wind, a slider), a pin set or moved (a grab), or set_particle()
+// wakes it, and it restarts from rest.
 #pragma once
 
 #include "clothsim/particle.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
+#include "clothsim/step_plan.hpp"
+#include "clothsim/step_profile.hpp"
+#include "clothsim/colliders.hpp"
 
 #include <glm/vec3.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -71,12 +83,28 @@ public:
     bool all_finite() const;
     // Whether settings().solver.method == Fast can run the fast grid solver (it needs a grid topology; it
     // runs position Verlet), and with how many threads the current settings step.
-    bool fast_solver_available() const { return grid_ != nullptr; }
+    bool fast_solver_available() const { return grid_.solver != nullptr; }
     int solver_threads() const;
     // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
     int last_solver_iterations() const { return last_iterations_; }
     // The fast solver's spring kernel on this CPU: "avx2+fma" or "generic" (chosen at run time).
     static const char* fast_kernel_name();
+
+    // The stages the current settings run (updated at the next step after a settings change).
+    const StepPlan& plan() const { return plan_; }
+    // Time per stage since the last reset_profile(); set_profiling(false) stops timing (and its clock reads).
+    const StepProfile& profile() const { return profile_; }
+    void reset_profile() { profile_ = StepProfile{}; }
+    void set_profiling(bool on) { profiling_ = on; }
+
+    bool asleep() const { return asleep_; }
+    // Asleep with no settings change waiting to wake it: the next step will not move anything.
+    bool resting() const { return asleep_ && settings_ == planned_; }
+    // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
+    void wake();
+    // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
+    // positions, even across copies (a rollback), so a renderer can skip normals and uploads.
+    std::uint64_t change_stamp() const { return stamp_; }
 
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
@@ -91,18 +119,47 @@ private:
     // when the substep length changes, so a new dt does not turn into a velocity jump).
     void restart(const std::vector<glm::vec3>& velocity, float h);
     void compute_forces(const State& state, Vec3Array& force) const;
-    bool wind_active() const;
+    void add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const;
+    void replan();
+    // The stages of step(), in pipeline order.
+    void step_fast_sweep(float h, StepProfile* profile);
+    void step_textbook(float h, StepProfile* profile);
     void step_velocity_integrator(Integrator integrator, float h);
-    void limit_strain_and_speed(float h);
+    void collide(StepProfile* profile);
+    void limit_strain();
+    void limit_speed(float h);
+    void check_sleep(float h);
+
+    // The fast solver, deep-copied with the simulation (GridSolver is internal to src/core).
+    struct FastSolver {
+        std::unique_ptr<GridSolver> solver;
+        FastSolver();
+        explicit FastSolver(std::unique_ptr<GridSolver> s);
+        FastSolver(const FastSolver& other);
+        FastSolver& operator=(const FastSolver& other);
+        FastSolver(FastSolver&&) noexcept;
+        FastSolver& operator=(FastSolver&&) noexcept;
+        ~FastSolver();
+    };
 
     Topology topology_;
     State state_;
     SimulationSettings settings_;
-    std::unique_ptr<GridSolver> grid_;  // the fast solver, when the topology is a grid
-    Vec3Array force_;        // N, scratch of the current substep
-    float rest_area_ = 0.0f; // m^2: sum of the triangles' rest areas
-    double carry_ = 0.0;     // s: time advance() has not yet stepped
+    FastSolver grid_;            // the fast solver, when the topology is a grid
+    SimulationSettings planned_; // the settings plan_ was made for
+    StepPlan plan_;
+    StepProfile profile_;
+    bool profiling_ = true;
+    CollisionBlocks blocks_;     // particle blocks and their boxes for the collision broad phase
+    Vec3Array force_;            // N, scratch of the current substep
+    Vec3Array wind_;             // N, scratch: wind summed on its own before it is added
+    float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
+    double carry_ = 0.0;         // s: time advance() has not yet stepped
     int last_iterations_ = 0;
+    bool asleep_ = false;
+    double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
+    int substeps_since_check_ = 0;
+    std::uint64_t stamp_ = 0;
 };
 
 // The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it

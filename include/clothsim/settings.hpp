@@ -55,6 +55,7 @@ struct SpringSettings {
     float bending = 10.0f;      // N/m: two apart along rows and columns
     float damping = 0.2f;       // 1/s: velocity damping rate c in x'' = a - c x'
     float strain_limit = 0.0f;  // fraction: 0 = off; otherwise no spring ends a substep longer than (1 + it) L0
+    bool operator==(const SpringSettings&) const = default;
 };
 
 struct ForceSettings {
@@ -65,6 +66,7 @@ struct ForceSettings {
     float gust_strength = 0.0f;             // fraction of the wind speed added and removed by gusts
     float gust_frequency = 0.5f;            // Hz: main gust frequency
     float max_speed = 0.0f;                 // m/s: 0 = off; otherwise particle speeds are clamped to it
+    bool operator==(const ForceSettings&) const = default;
 };
 
 // Which particles are pinned: a named preset and/or explicit (row, col) pairs.
@@ -79,6 +81,7 @@ struct SphereCollider {
     glm::vec3 center{0.0f, 0.5f, 0.0f};  // m
     float radius = 0.3f;                 // m
     float friction = 0.3f;               // Coulomb coefficient (0 = frictionless)
+    bool operator==(const SphereCollider&) const = default;
 };
 
 struct CubeCollider {
@@ -86,12 +89,14 @@ struct CubeCollider {
     glm::vec3 center{0.0f, 0.4f, 0.0f};     // m
     glm::vec3 size{0.5f, 0.5f, 0.5f};       // m: edge lengths along x, y, z (axis-aligned)
     float friction = 0.3f;
+    bool operator==(const CubeCollider&) const = default;
 };
 
 struct GroundCollider {
     bool enabled = true;
     float height = 0.0f;     // m: the plane y = height
     float friction = 0.5f;
+    bool operator==(const GroundCollider&) const = default;
 };
 
 struct ColliderSettings {
@@ -99,6 +104,7 @@ struct ColliderSettings {
     CubeCollider cube;
     GroundCollider ground;
     float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
+    bool operator==(const ColliderSettings&) const = default;
 };
 
 inline constexpr int kMaxSubsteps = 10000;  // the largest integration.substeps a scene may hold
@@ -108,11 +114,16 @@ struct IntegrationSettings {
     int substeps = 34;        // integration substeps per step; each advances dt / substeps
     Integrator integrator = Integrator::Verlet;
     float tolerance = 1e-5f;  // implicit Euler: CG stops at this residual relative to the right-hand side
+    bool operator==(const IntegrationSettings&) const = default;
 };
 
 struct SolverSettings {
     SolverMethod method = SolverMethod::Fast;
     int threads = 0;  // worker threads for the fast solver; 0 = one per core
+    bool broad_phase = true;   // test a collider only against the particle blocks whose bounds meet it
+    float sleep_speed = 0.002f;  // m/s: 0 = never sleep; else the cloth sleeps once every particle is slower
+    float sleep_time = 0.5f;     // s: ... for this long, with nothing driving it (docs/PERFORMANCE.md)
+    bool operator==(const SolverSettings&) const = default;
 };
 
 // The settings a running simulation reads every step; all of them may change live.
@@ -122,6 +133,7 @@ struct SimulationSettings {
     ColliderSettings colliders;
     IntegrationSettings integration;
     SolverSettings solver;
+    bool operator==(const SimulationSettings&) const = default;
 };
 
 // Everything a scene file holds. Changing cloth or pins needs a rebuild; the rest applies live.

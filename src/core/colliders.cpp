@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
 namespace clothsim {
 namespace {
@@ -57,46 +56,17 @@ Contact<T> contact(const GroundCollider& ground, glm::vec<3, T> p, T thickness) 
     return {glm::vec<3, T>(T(0), T(1), T(0)), T(ground.height) + thickness - p.y};
 }
 
-// Cheap tests, written so the compiler vectorises them, of whether any particle of a range is close
-// enough to need the full contact: most rows of a cloth touch nothing, and then cost one pass of compares.
-bool any_near(const State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
-    const float reach = (sphere.radius + thickness) * (sphere.radius + thickness);
-    bool any = false;
-    for (std::size_t i = begin; i < end; ++i) {
-        const float dx = state.position.x[i] - sphere.center.x, dy = state.position.y[i] - sphere.center.y,
-                    dz = state.position.z[i] - sphere.center.z;
-        any |= dx * dx + dy * dy + dz * dz < reach;
-    }
-    return any;
-}
-bool any_near(const State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
-    const glm::vec3 lo = cube.center - 0.5f * cube.size - thickness, hi = cube.center + 0.5f * cube.size + thickness;
-    bool any = false;
-    for (std::size_t i = begin; i < end; ++i) {
-        const float x = state.position.x[i], y = state.position.y[i], z = state.position.z[i];
-        any |= (x > lo.x) & (x < hi.x) & (y > lo.y) & (y < hi.y) & (z > lo.z) & (z < hi.z);
-    }
-    return any;
-}
-bool any_near(const State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
-    const float top = ground.height + thickness;
-    bool any = false;
-    for (std::size_t i = begin; i < end; ++i) any |= state.position.y[i] < top;
-    return any;
-}
-
+// Returns whether it moved a particle. A NaN position has NaN depth and is left alone (the guard reports it).
 template <class T, class Shape>
-void collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
+bool collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
                    std::size_t end) {
     using Vec = glm::vec<3, T>;
-    // NaN positions fail every compare in any_near; they stay NaN either way (the guard reports them).
-    if constexpr (std::is_same_v<T, float>) {
-        if (!any_near(state, shape, thickness, begin, end)) return;
-    }
+    bool moved = false;
     for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
         const Contact<T> c = contact(shape, state.position.get(i), thickness);
         if (!(c.depth > T(0))) continue;
+        moved = true;
         const Vec motion = state.motion.get(i);
         const T normal_motion = glm::dot(motion, c.normal);
         const Vec tangential = motion - normal_motion * c.normal;
@@ -108,6 +78,26 @@ void collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thick
         // the motion (x_prev left in place, as plain Verlet projection does) turns a deep penetration into a
         // velocity of depth / h: a cloth started half inside the sphere exploded that way.
         state.motion.set(i, tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal);
+    }
+    return moved;
+}
+
+template <class Shape>
+void collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
+                    std::size_t which, StepProfile* profile) {
+    const std::size_t n = state.size(), size = blocks.size;
+    long long tested = 0;
+    for (std::size_t k = 0, begin = 0; begin < n; ++k, begin += size) {
+        const std::size_t end = std::min(n, begin + size);
+        if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
+        ++tested;
+        if (collide_shape(state, shape, shape.friction, thickness, begin, end) && broad_phase) {
+            blocks.boxes[k] = particle_bounds(state.position, begin, end);
+        }
+    }
+    if (profile) {
+        profile->blocks_tested[which] += tested;
+        profile->blocks_offered[which] += static_cast<long long>(blocks.boxes.size());
     }
 }
 
@@ -132,6 +122,44 @@ void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::s
     if (colliders.cube.enabled) collide_shape(state, colliders.cube, T(colliders.cube.friction), thickness, begin, end);
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
+void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
+                   StepProfile* profile) {
+    const std::size_t n = state.size(), size = std::max<std::size_t>(blocks.size, 1);
+    blocks.size = size;
+    const std::size_t count = (n + size - 1) / size;
+    const bool any = colliders.sphere.enabled || colliders.cube.enabled || colliders.ground.enabled;
+    if (!any) return;
+    auto prepare = [&] {  // timed with the first collider that runs
+        if (!broad_phase) {
+            blocks.boxes.resize(count);  // only counted: every block is tested
+            blocks.current = false;
+            return;
+        }
+        if (blocks.current && blocks.boxes.size() == count) return;
+        blocks.boxes.resize(count);
+        for (std::size_t k = 0; k < count; ++k) {
+            blocks.boxes[k] = particle_bounds(state.position, k * size, std::min(n, (k + 1) * size));
+        }
+        blocks.current = true;
+    };
+    const float thickness = colliders.thickness;
+    if (colliders.sphere.enabled) {
+        StageTimer timer(profile, Stage::Sphere);
+        prepare();
+        collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, 0, profile);
+    }
+    if (colliders.cube.enabled) {
+        StageTimer timer(profile, Stage::Cube);
+        prepare();
+        collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, 1, profile);
+    }
+    if (colliders.ground.enabled) {
+        StageTimer timer(profile, Stage::Ground);
+        prepare();
+        collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, 2, profile);
+    }
+}
+
 template void collide_all<float>(State&, const ColliderSettings&, std::size_t, std::size_t);
 template void collide_all<double>(DState&, const ColliderSettings&, std::size_t, std::size_t);
 

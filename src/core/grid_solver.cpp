@@ -1,6 +1,6 @@
 #include "grid_solver.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "clothsim/broad_phase.hpp"
 #include "verlet.hpp"
 
 #include <immintrin.h>
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <thread>
+#include <utility>
 
 namespace clothsim {
 namespace {
@@ -117,6 +118,7 @@ std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
                 if (r1 - r0 == dir.dr && c1 - c0 == dir.dc) {
                     if (!std::isnan(solver.rest_[d][start])) return std::nullopt;  // a duplicate spring
                     solver.rest_[d][start] = s.rest_length;
+                    solver.present_[d] = true;
                     placed = true;
                     break;
                 }
@@ -130,8 +132,9 @@ std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
             for (int c = 0; c < t.cols; ++c) {
                 float& rest = solver.rest_[d][static_cast<std::size_t>(r) * t.cols + c];
                 const bool inside = r + dir.dr < t.rows && c >= first_column(dir) && c < end_column(dir, t.cols);
-                if (inside && std::isnan(rest)) return std::nullopt;  // the sweep would add a spring
-                if (!inside) rest = 0.0f;
+                // A direction with some springs must have all: the sweep would add the missing ones.
+                if (inside && solver.present_[d] && std::isnan(rest)) return std::nullopt;
+                if (!inside || !solver.present_[d]) rest = 0.0f;
             }
         }
     }
@@ -144,9 +147,9 @@ int GridSolver::effective_threads(int requested) const {
     return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
 }
 
-void GridSolver::step(State& state, const SimulationSettings& settings, const Vec3Array* external, float h,
-                      int threads) {
-    const int blocks = effective_threads(threads);
+void GridSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
+                      const Vec3Array* external, float h, std::vector<Box>* row_boxes) {
+    const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
     // Buffers and the block layout are set up again only when the block count changes.
     if (blocks != blocks_) {
@@ -162,9 +165,11 @@ void GridSolver::step(State& state, const SimulationSettings& settings, const Ve
             boundary_slot_[begin - 1] = 2 * b + 1;
         }
     }
+    if (row_boxes) row_boxes->resize(rows_);
+    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
     auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
     if (blocks == 1) {
-        sweep(state, settings, external, h, 0, rows_, scratch_[0]);
+        sweep(state, sweep_settings, 0, rows_, scratch_[0]);
         state.substep = h;
         return;
     }
@@ -178,13 +183,13 @@ void GridSolver::step(State& state, const SimulationSettings& settings, const Ve
         for (int b = omp_get_thread_num(); b + 1 < blocks; b += team) {
             const int next = block_begin(b + 1);
             for (int r : {next - 2, next - 1}) {
-                spring_row(state, settings.springs, r,
+                spring_row(state, settings.springs, spring_mask, r,
                            boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
             }
         }
 #pragma omp barrier
         for (int b = omp_get_thread_num(); b < blocks; b += team) {
-            sweep(state, settings, external, h, block_begin(b), block_begin(b + 1), scratch_[b]);
+            sweep(state, sweep_settings, block_begin(b), block_begin(b + 1), scratch_[b]);
         }
     }
     state.substep = h;
@@ -197,22 +202,28 @@ namespace {
 struct Grid {
     int rows, cols;
     const std::array<std::vector<float>, 6>& rest;
+    const std::array<bool, 6>& present;
     std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
     // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
     std::size_t row_floats() const { return 18 * stride(); }
 };
 
-template <bool Avx2>
+constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
+
+// Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
+template <bool Avx2, unsigned Mask>
 [[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state,
                                                    const SpringSettings& springs, int r, float* out) {
     const std::size_t stride = grid.stride();
     const float stiffness[3] = {springs.structural, springs.shear, springs.bending};
     for (int d = 0; d < 6; ++d) {
         const Direction& dir = kDirections[d];
+        if (!kind_runs(Mask, dir.kind)) continue;
         float* f = out + 3 * d * stride + kPad;  // column 0 of component x
         const int c0 = first_column(dir), c1 = end_column(dir, grid.cols);
-        // Columns without a spring, the padding and rows past the bottom hold zero.
-        const bool any = r + dir.dr < grid.rows && c1 > c0;
+        // Columns without a spring, the padding, rows past the bottom and a direction the topology lacks
+        // hold zero.
+        const bool any = grid.present[d] && r + dir.dr < grid.rows && c1 > c0;
         for (int comp = 0; comp < 3; ++comp) {
             float* row = f + comp * stride;
             if (!any) {
@@ -243,6 +254,7 @@ template <bool Avx2>
 // the one starting there, external force last. Then position Verlet for the row (gravity and damping
 // inside). A particle with inverse mass 0 is pinned and does not move. Every particle is read and written
 // once.
+template <unsigned Mask, bool Ext>
 [[gnu::always_inline]] inline void integrate_row(const float* __restrict f0, const float* __restrict f1,
                                                  const float* __restrict f2, const float* __restrict ext,
                                                  float* __restrict x, float* __restrict m,
@@ -252,13 +264,19 @@ template <bool Avx2>
     const std::size_t D = 3 * stride;
     for (int c = 0; c < cols; ++c) {
         float f = 0.0f;
-        f = (f - f0[c - 1]) + f0[c];                      // (0,+1)
-        f = (f - f1[D + c]) + f0[D + c];                  // (+1,0)
-        f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];      // (+1,+1)
-        f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];      // (+1,-1)
-        f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];      // (0,+2)
-        f = (f - f2[5 * D + c]) + f0[5 * D + c];          // (+2,0)
-        f += ext[c];
+        if constexpr (kind_runs(Mask, SpringKind::Structural)) {
+            f = (f - f0[c - 1]) + f0[c];                  // (0,+1)
+            f = (f - f1[D + c]) + f0[D + c];              // (+1,0)
+        }
+        if constexpr (kind_runs(Mask, SpringKind::Shear)) {
+            f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];  // (+1,+1)
+            f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];  // (+1,-1)
+        }
+        if constexpr (kind_runs(Mask, SpringKind::Bending)) {
+            f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];  // (0,+2)
+            f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
+        }
+        if constexpr (Ext) f += ext[c];
         const float moved = m[c] * keep + (f * w[c] + g) * h2;
         const float step = w[c] == 0.0f ? 0.0f : moved;  // a select, not a branch: the loop vectorises
         m[c] = step;
@@ -266,78 +284,106 @@ template <bool Avx2>
     }
 }
 
-template <bool Avx2>
-[[gnu::always_inline]] inline void sweep_body(const Grid& grid, const std::vector<float>& boundary,
-                                              const std::vector<int>& boundary_slot, State& state,
-                                              const SimulationSettings& settings, const Vec3Array* external, float h,
-                                              int begin, int end, float* window, const float* zeros) {
+// Everything the sweep of one row block reads besides the state.
+struct SweepInput {
+    const Grid& grid;
+    const std::vector<float>& boundary;
+    const std::vector<int>& boundary_slot;
+    const SimulationSettings& settings;
+    const Vec3Array* external;
+    float h;
+    Box* row_boxes;  // the box of each row after its update, or null when no collider runs
+    float* window;
+    const float* zeros;
+};
+
+template <bool Avx2, unsigned Mask>
+[[gnu::always_inline]] inline void sweep_body(const SweepInput& in, State& state, int begin, int end) {
+    const Grid& grid = in.grid;
     const std::size_t stride = grid.stride();
     const std::size_t row_floats = grid.row_floats();
-    const auto [keep, h2] = verlet_coefficients(settings.springs.damping, h);
-    const glm::vec3 g = settings.forces.gravity;
+    const auto [keep, h2] = verlet_coefficients(in.settings.springs.damping, in.h);
+    const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
-    const float* spring_rows[3] = {zeros, zeros, zeros};
+    const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
     for (int r = std::max(begin - 2, 0); r < end; ++r) {
         const float* current;
-        if (boundary_slot[r] >= 0) {
-            current = boundary.data() + static_cast<std::size_t>(boundary_slot[r]) * row_floats;
+        if (in.boundary_slot[r] >= 0) {
+            current = in.boundary.data() + static_cast<std::size_t>(in.boundary_slot[r]) * row_floats;
         } else {
-            float* slot = window + static_cast<std::size_t>(r % 3) * row_floats;
-            spring_row_body<Avx2>(grid, state, settings.springs, r, slot);
+            float* slot = in.window + static_cast<std::size_t>(r % 3) * row_floats;
+            spring_row_body<Avx2, Mask>(grid, state, in.settings.springs, r, slot);
             current = slot;
         }
         spring_rows[2] = spring_rows[1];
         spring_rows[1] = spring_rows[0];
         spring_rows[0] = current;
         if (r < begin) continue;
-        // Row r is complete: gather its forces, integrate it in place, collide it.
+        // Row r is complete: gather its forces and integrate it in place. No later spring row reads row r,
+        // so the collision stage may move it after the sweep.
         const std::size_t i0 = static_cast<std::size_t>(r) * grid.cols;
         float* position[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
         float* motion[3] = {state.motion.x.data() + i0, state.motion.y.data() + i0, state.motion.z.data() + i0};
-        const float* ext[3] = {zeros, zeros, zeros};  // no external force: add zeros, keep one loop
-        if (external) ext[0] = external->x.data() + i0, ext[1] = external->y.data() + i0, ext[2] = external->z.data() + i0;
         const float gravity[3] = {g.x, g.y, g.z};
+        const float* w = state.inverse_mass.data() + i0;
         for (int comp = 0; comp < 3; ++comp) {
             const std::size_t at = comp * stride + kPad;
-            integrate_row(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, ext[comp], position[comp],
-                          motion[comp], state.inverse_mass.data() + i0, grid.cols, stride, gravity[comp], keep, h2);
+            if (in.external) {
+                const float* ext = (comp == 0 ? in.external->x : comp == 1 ? in.external->y : in.external->z).data() + i0;
+                integrate_row<Mask, true>(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, ext,
+                                          position[comp], motion[comp], w, grid.cols, stride, gravity[comp], keep, h2);
+            } else {
+                integrate_row<Mask, false>(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, nullptr,
+                                           position[comp], motion[comp], w, grid.cols, stride, gravity[comp], keep, h2);
+            }
         }
-        collide_all(state, settings.colliders, i0, i0 + grid.cols);
+        // The row is still in L1: its box for the collision broad phase costs one more pass over it.
+        if (in.row_boxes) in.row_boxes[r] = particle_bounds(state.position, i0, i0 + grid.cols);
     }
 }
 
+// One compiled sweep per spring-kind mask and instruction set, picked from a table at run time.
+template <unsigned Mask>
 __attribute__((target("avx2,fma"))) void spring_row_avx2(const Grid& grid, const State& state,
                                                           const SpringSettings& springs, int r, float* out) {
-    spring_row_body<true>(grid, state, springs, r, out);
+    spring_row_body<true, Mask>(grid, state, springs, r, out);
 }
+template <unsigned Mask>
 void spring_row_generic(const Grid& grid, const State& state, const SpringSettings& springs, int r, float* out) {
-    spring_row_body<false>(grid, state, springs, r, out);
+    spring_row_body<false, Mask>(grid, state, springs, r, out);
+}
+template <unsigned Mask>
+__attribute__((target("avx2,fma"))) void sweep_avx2(const SweepInput& in, State& state, int begin, int end) {
+    sweep_body<true, Mask>(in, state, begin, end);
+}
+template <unsigned Mask>
+void sweep_generic(const SweepInput& in, State& state, int begin, int end) {
+    sweep_body<false, Mask>(in, state, begin, end);
 }
 
-__attribute__((target("avx2,fma"))) void sweep_avx2(const Grid& grid, const std::vector<float>& boundary,
-                                                     const std::vector<int>& boundary_slot, State& state,
-                                                     const SimulationSettings& settings, const Vec3Array* external,
-                                                     float h, int begin, int end, float* window, const float* zeros) {
-    sweep_body<true>(grid, boundary, boundary_slot, state, settings, external, h, begin, end, window, zeros);
+using SpringRowFn = void (*)(const Grid&, const State&, const SpringSettings&, int, float*);
+using SweepFn = void (*)(const SweepInput&, State&, int, int);
+template <std::size_t... M>
+constexpr std::array<SpringRowFn, 8> spring_row_table(bool avx2, std::index_sequence<M...>) {
+    return avx2 ? std::array<SpringRowFn, 8>{spring_row_avx2<M>...} : std::array<SpringRowFn, 8>{spring_row_generic<M>...};
 }
-void sweep_generic(const Grid& grid, const std::vector<float>& boundary, const std::vector<int>& boundary_slot,
-                   State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int begin,
-                   int end, float* window, const float* zeros) {
-    sweep_body<false>(grid, boundary, boundary_slot, state, settings, external, h, begin, end, window, zeros);
+template <std::size_t... M>
+constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...>) {
+    return avx2 ? std::array<SweepFn, 8>{sweep_avx2<M>...} : std::array<SweepFn, 8>{sweep_generic<M>...};
 }
 
 }  // namespace
 
-void GridSolver::spring_row(const State& state, const SpringSettings& springs, int r, float* out) const {
-    const Grid grid{rows_, cols_, rest_};
-    kAvx2 ? spring_row_avx2(grid, state, springs, r, out) : spring_row_generic(grid, state, springs, r, out);
+void GridSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
+    const Grid grid{rows_, cols_, rest_, present_};
+    spring_row_table(kAvx2, std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
-void GridSolver::sweep(State& state, const SimulationSettings& settings, const Vec3Array* external, float h,
-                       int begin, int end, Scratch& scratch) {
-    const Grid grid{rows_, cols_, rest_};
-    (kAvx2 ? sweep_avx2 : sweep_generic)(grid, boundary_, boundary_slot_, state, settings, external, h, begin, end,
-                                         scratch.window.data(), zeros_.data());
+void GridSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch) {
+    const Grid grid{rows_, cols_, rest_, present_};
+    const SweepInput in{grid, boundary_, boundary_slot_, sweep.settings, sweep.external, sweep.h,
+                        sweep.row_boxes, scratch.window.data(), zeros_.data()};
+    sweep_table(kAvx2, std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }
 
 }  // namespace clothsim

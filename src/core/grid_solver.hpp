@@ -15,6 +15,7 @@
 //    any partition, so the result is bit-identical for any thread count.
 #pragma once
 
+#include "clothsim/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
@@ -26,11 +27,15 @@ namespace clothsim {
 
 class GridSolver {
 public:
-    // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions.
+    // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions, each
+    // direction either complete or absent (a cloth built without bending springs).
     static std::optional<GridSolver> for_topology(const Topology& topology);
 
-    // One substep: springs + `external` forces (N per particle, or null), Verlet update, collisions.
-    void step(State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int threads);
+    // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
+    // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
+    // caller's next stage; for it, `row_boxes` (when not null) receives each row's box after the update.
+    void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
+              float h, std::vector<Box>* row_boxes);
 
     // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
     // at least 8.
@@ -47,13 +52,20 @@ private:
     struct Scratch {
         std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
     };
-    void sweep(State& state, const SimulationSettings& settings, const Vec3Array* external, float h, int begin,
-               int end, Scratch& scratch);
-    // Forces of the springs starting in row r, into out[d][component][c] (6 x 3 x cols).
-    void spring_row(const State& state, const SpringSettings& springs, int r, float* out) const;
+    struct SweepSettings {
+        const SimulationSettings& settings;
+        unsigned mask;
+        const Vec3Array* external;
+        float h;
+        Box* row_boxes;
+    };
+    void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch);
+    // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).
+    void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const;
 
     int rows_, cols_;
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
+    std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

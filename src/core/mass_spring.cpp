@@ -10,10 +10,33 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 
 namespace clothsim {
+
+namespace {
+
+// Stamps are unique across all simulations, so a copy keeps its stamp and a new cloth never reuses one.
+std::uint64_t next_stamp() {
+    static std::atomic<std::uint64_t> counter{0};
+    return ++counter;
+}
+
+}  // namespace
+
+MassSpring::FastSolver::FastSolver() = default;
+MassSpring::FastSolver::FastSolver(std::unique_ptr<GridSolver> s) : solver(std::move(s)) {}
+MassSpring::FastSolver::FastSolver(const FastSolver& other)
+    : solver(other.solver ? std::make_unique<GridSolver>(*other.solver) : nullptr) {}
+MassSpring::FastSolver& MassSpring::FastSolver::operator=(const FastSolver& other) {
+    if (this != &other) solver = other.solver ? std::make_unique<GridSolver>(*other.solver) : nullptr;
+    return *this;
+}
+MassSpring::FastSolver::FastSolver(FastSolver&&) noexcept = default;
+MassSpring::FastSolver& MassSpring::FastSolver::operator=(FastSolver&&) noexcept = default;
+MassSpring::FastSolver::~FastSolver() = default;
 
 MassSpring::MassSpring(Topology topology, State state, SimulationSettings settings,
                        const std::vector<glm::vec3>& initial_velocity)
@@ -23,115 +46,203 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
         (!initial_velocity.empty() && initial_velocity.size() != n)) {
         throw std::invalid_argument("MassSpring: state arrays and initial velocities must have equal length");
     }
+    // The plan reads the counts; a hand-made topology may not have filled them in.
+    topology_.spring_count_by_kind = {};
+    for (const Spring& s : topology_.springs) ++topology_.spring_count_by_kind[static_cast<int>(s.kind)];
     for (const auto& t : topology_.triangles) {
         const glm::vec3 a = state_.position.get(t[0]);
         rest_area_ += 0.5f * glm::length(glm::cross(state_.position.get(t[1]) - a, state_.position.get(t[2]) - a));
     }
     force_.resize(n);
     state_.motion.resize(n);
-    if (auto grid = GridSolver::for_topology(topology_)) grid_ = std::make_unique<GridSolver>(std::move(*grid));
+    if (auto grid = GridSolver::for_topology(topology_)) grid_ = FastSolver(std::make_unique<GridSolver>(std::move(*grid)));
+    // Blocks of the collision broad phase: grid rows (the fast solver's boxes are per row), else fixed runs.
+    const bool grid_shape = topology_.cols > 0 && static_cast<std::size_t>(topology_.rows) * topology_.cols == n;
+    blocks_.size = grid_shape ? static_cast<std::size_t>(topology_.cols) : kBlockParticles;
+    replan();
     restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
             substep_length());
+    stamp_ = next_stamp();
 }
 
 MassSpring::~MassSpring() = default;
+MassSpring::MassSpring(const MassSpring&) = default;
+MassSpring& MassSpring::operator=(const MassSpring&) = default;
 MassSpring::MassSpring(MassSpring&&) noexcept = default;
 MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
-MassSpring::MassSpring(const MassSpring& other)
-    : topology_(other.topology_),
-      state_(other.state_),
-      settings_(other.settings_),
-      grid_(other.grid_ ? std::make_unique<GridSolver>(*other.grid_) : nullptr),
-      force_(other.force_),
-      rest_area_(other.rest_area_),
-      carry_(other.carry_),
-      last_iterations_(other.last_iterations_) {}
-MassSpring& MassSpring::operator=(const MassSpring& other) {
-    if (this != &other) *this = MassSpring(other);
-    return *this;
-}
 
 const char* MassSpring::fast_kernel_name() { return GridSolver::kernel_name(); }
 
 int MassSpring::solver_threads() const {
-    const bool fast = grid_ && settings_.solver.method == SolverMethod::Fast &&
-                      settings_.integration.integrator == Integrator::Verlet;
-    return fast ? grid_->effective_threads(settings_.solver.threads) : 1;
+    return plan_.path == StepPath::FastSweep ? grid_.solver->effective_threads(settings_.solver.threads) : 1;
 }
 
 float MassSpring::substep_length() const {
     return settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
 }
 
-// The whole pipeline of one substep, in order: forces (springs, wind), integration (gravity and damping
-// inside), collisions. The fast solver runs the same stages fused row by row (grid_solver.hpp says why).
+// The whole pipeline of one substep, in order. The stages come from the plan (step_plan.hpp), made again
+// here when the settings have changed since; a stage the plan leaves out is not run, not even as a branch
+// per particle.
 void MassSpring::step() {
+    if (!(settings_ == planned_)) {
+        replan();
+        wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
+    }
     const float h = substep_length();
+    if (asleep_) {
+        state_.time += h;
+        ++profile_.slept_substeps;
+        return;
+    }
+    StepProfile* profile = profiling_ ? &profile_ : nullptr;
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || static_cast<int>(integrator) != state_.integrator) restart(velocities(), h);
 
-    if (integrator != Integrator::Verlet) {
-        step_velocity_integrator(integrator, h);
-        collide_all(state_, settings_.colliders);
-    } else if (grid_ && settings_.solver.method == SolverMethod::Fast) {
-        const Vec3Array* external = nullptr;
-        if (wind_active()) {
-            force_.resize(state_.size());
-            accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
-            external = &force_;
-        }
-        grid_->step(state_, settings_, external, h, settings_.solver.threads);
-    } else {
-        compute_forces(state_, force_);
-        integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
-        collide_all(state_, settings_.colliders);
+    switch (plan_.path) {
+        case StepPath::FastSweep: step_fast_sweep(h, profile); break;
+        case StepPath::Textbook: step_textbook(h, profile); break;
+        case StepPath::VelocityIntegrator: {
+            StageTimer timer(profile, Stage::Integrate);
+            step_velocity_integrator(integrator, h);
+        } break;
     }
-    if (settings_.springs.strain_limit > 0.0f || settings_.forces.max_speed > 0.0f) {
-        limit_strain_and_speed(h);
-        collide_all(state_, settings_.colliders);  // a correction must not leave a particle inside a collider
+    collide(profile);
+    if (plan_.strain_limit || plan_.speed_limit) {
+        if (plan_.strain_limit) {
+            StageTimer timer(profile, Stage::StrainLimit);
+            limit_strain();
+        }
+        if (plan_.speed_limit) {
+            StageTimer timer(profile, Stage::SpeedLimit);
+            limit_speed(h);
+        }
+        blocks_.current = false;
+        collide(profile);  // a correction must not leave a particle inside a collider
     }
     state_.time += h;
+    ++profile_.substeps;
+    stamp_ = next_stamp();
+    if (++substeps_since_check_ >= settings_.integration.substeps) {
+        substeps_since_check_ = 0;
+        if (plan_.may_sleep) {
+            StageTimer timer(profile, Stage::Sleep);
+            check_sleep(h);
+        }
+    }
+}
+
+// Fast solver: wind first (it reads the positions before the sweep moves them), then one fused sweep that
+// also leaves each row's box for the collision broad phase.
+void MassSpring::step_fast_sweep(float h, StepProfile* profile) {
+    const Vec3Array* external = nullptr;
+    if (plan_.wind) {
+        StageTimer timer(profile, Stage::Wind);
+        force_.resize(state_.size());
+        accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
+        external = &force_;
+    }
+    const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
+    {
+        StageTimer timer(profile, Stage::Sweep);
+        grid_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr);
+    }
+    blocks_.current = boxes;
+}
+
+void MassSpring::step_textbook(float h, StepProfile* profile) {
+    {
+        StageTimer timer(profile, Stage::Springs);
+        force_.resize(state_.size());
+        if (plan_.any_springs()) accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
+    }
+    if (plan_.wind) {
+        StageTimer timer(profile, Stage::Wind);
+        add_wind_forces(state_, force_, wind_);
+    }
+    {
+        StageTimer timer(profile, Stage::Integrate);
+        integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+    }
+    blocks_.current = false;
+}
+
+void MassSpring::collide(StepProfile* profile) {
+    if (!plan_.any_collider()) return;
+    collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
+}
+
+void MassSpring::replan() {
+    plan_ = plan_step(topology_, settings_, grid_.solver != nullptr);
+    planned_ = settings_;
+}
+
+void MassSpring::wake() {
+    calm_seconds_ = 0.0;
+    substeps_since_check_ = 0;
+    if (!asleep_) return;
+    asleep_ = false;
+    restart(std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f)), substep_length());
+}
+
+// Once per step: the largest displacement of a free particle in the last substep, against sleep_speed x h.
+// NaN motion never counts as calm.
+void MassSpring::check_sleep(float h) {
+    const float limit = settings_.solver.sleep_speed * h;
+    float fastest = 0.0f;  // squared
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        const glm::vec3 m = state_.motion.get(i);
+        const float m2 = state_.pinned[i] ? 0.0f : glm::dot(m, m);
+        if (!(m2 <= fastest)) fastest = m2;
+    }
+    if (fastest < limit * limit) {
+        calm_seconds_ += static_cast<double>(h) * settings_.integration.substeps;
+    } else {
+        calm_seconds_ = 0.0;
+    }
+    if (calm_seconds_ + 1e-9 >= settings_.solver.sleep_time) {
+        asleep_ = true;
+        for (std::size_t i = 0; i < state_.size(); ++i) state_.motion.set(i, glm::vec3(0.0f));
+    }
 }
 
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
 // moving in proportion to their inverse masses (one Gauss-Seidel pass, spring-list order). The correction
 // adds no velocity of its own (like a collision push), and the ends' motion apart along the spring is
 // removed, shared by inverse mass so momentum is kept: a spring held at its limit stops stretching instead
-// of storing speed it cannot use. Then any particle moving faster than max_speed is slowed to it, its
-// substep's displacement shortened with it. Both change the model where they act (docs/STABILITY.md).
-void MassSpring::limit_strain_and_speed(float h) {
+// of storing speed it cannot use. It changes the model where it acts (docs/STABILITY.md).
+void MassSpring::limit_strain() {
     const float limit = settings_.springs.strain_limit;
-    if (limit > 0.0f) {
-        for (const Spring& s : topology_.springs) {
-            if (s.rest_length == 0.0f) continue;
-            const float wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
-            if (wa + wb == 0.0f) continue;
-            const glm::vec3 d = state_.position.get(s.b) - state_.position.get(s.a);
-            const float length = glm::length(d);
-            const float longest = (1.0f + limit) * s.rest_length;
-            if (!(length > longest)) continue;
-            const glm::vec3 shorten = d * ((length - longest) / (length * (wa + wb)));
-            state_.position.add(s.a, wa * shorten);
-            state_.position.add(s.b, -wb * shorten);
-            const glm::vec3 n = d / length;
-            const float apart = glm::dot(state_.motion.get(s.b) - state_.motion.get(s.a), n);
-            if (apart > 0.0f) {
-                state_.motion.add(s.a, (wa / (wa + wb)) * apart * n);
-                state_.motion.add(s.b, -(wb / (wa + wb)) * apart * n);
-            }
+    for (const Spring& s : topology_.springs) {
+        if (s.rest_length == 0.0f) continue;
+        const float wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
+        if (wa + wb == 0.0f) continue;
+        const glm::vec3 d = state_.position.get(s.b) - state_.position.get(s.a);
+        const float length = glm::length(d);
+        const float longest = (1.0f + limit) * s.rest_length;
+        if (!(length > longest)) continue;
+        const glm::vec3 shorten = d * ((length - longest) / (length * (wa + wb)));
+        state_.position.add(s.a, wa * shorten);
+        state_.position.add(s.b, -wb * shorten);
+        const glm::vec3 n = d / length;
+        const float apart = glm::dot(state_.motion.get(s.b) - state_.motion.get(s.a), n);
+        if (apart > 0.0f) {
+            state_.motion.add(s.a, (wa / (wa + wb)) * apart * n);
+            state_.motion.add(s.b, -(wb / (wa + wb)) * apart * n);
         }
     }
-    const float max_speed = settings_.forces.max_speed;
-    if (max_speed > 0.0f) {
-        const float longest_step = max_speed * h;
-        for (std::size_t i = 0; i < state_.size(); ++i) {
-            const glm::vec3 m = state_.motion.get(i);
-            const float step = glm::length(m);
-            if (!(step > longest_step)) continue;
-            const glm::vec3 clamped = m * (longest_step / step);
-            state_.position.add(i, clamped - m);  // the substep moved the particle by m: move it by clamped
-            state_.motion.set(i, clamped);
-        }
+}
+
+// Any particle moving faster than max_speed is slowed to it, its substep's displacement shortened with it.
+void MassSpring::limit_speed(float h) {
+    const float longest_step = settings_.forces.max_speed * h;
+    for (std::size_t i = 0; i < state_.size(); ++i) {
+        const glm::vec3 m = state_.motion.get(i);
+        const float step = glm::length(m);
+        if (!(step > longest_step)) continue;
+        const glm::vec3 clamped = m * (longest_step / step);
+        state_.position.add(i, clamped - m);  // the substep moved the particle by m: move it by clamped
+        state_.motion.set(i, clamped);
     }
 }
 
@@ -140,7 +251,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, float h) {
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
-        if (wind_active()) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
+        if (plan_.wind) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
     switch (integrator) {
@@ -155,19 +266,19 @@ void MassSpring::step_velocity_integrator(Integrator integrator, float h) {
     }
 }
 
-bool MassSpring::wind_active() const {
-    return settings_.forces.wind != glm::vec3(0.0f) || settings_.forces.wind_model == WindModel::Uniform;
+// Wind is summed on its own and added last, as the fast solver adds it, so both round alike.
+void MassSpring::add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const {
+    scratch.resize(state.size());
+    accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, scratch);
+    for (std::size_t i = 0; i < state.size(); ++i) force.add(i, scratch.get(i));
 }
 
 void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
     force.resize(state.size());
     accumulate_spring_forces(topology_, state.position, settings_.springs, force);
-    if (wind_active()) {
-        // Wind is summed on its own and added last, as the fast solver adds it, so both round alike.
+    if (wind_active(settings_.forces)) {
         Vec3Array wind;
-        wind.resize(state.size());
-        accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, wind);
-        for (std::size_t i = 0; i < state.size(); ++i) force.add(i, wind.get(i));
+        add_wind_forces(state, force, wind);
     }
 }
 
@@ -214,6 +325,7 @@ std::vector<glm::vec3> MassSpring::positions() const {
 }
 
 std::vector<glm::vec3> MassSpring::velocities() const {
+    if (asleep_) return std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f));
     if (state_.integrator != static_cast<int>(Integrator::Verlet)) {
         std::vector<glm::vec3> v(state_.size(), glm::vec3(0.0f));
         if (state_.substep > 0.0f) {
@@ -260,6 +372,8 @@ bool MassSpring::all_finite() const {
 }
 
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
+    wake();
+    stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? 1 : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::vec3(0.0f));
@@ -267,11 +381,15 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
 
 void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
     if (!state_.pinned.at(i)) return;
+    wake();
+    stamp_ = next_stamp();
     state_.position.set(i, position);
     state_.motion.set(i, glm::vec3(0.0f));
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {
+    wake();
+    stamp_ = next_stamp();
     std::vector<glm::vec3> v = velocities();
     state_.position.set(i, position);
     v.at(i) = state_.pinned[i] ? glm::vec3(0.0f) : velocity;

@@ -1,0 +1,58 @@
+// StepPlan: which stages a substep runs, chosen from the scene.
+//
+// MassSpring builds the plan when it is constructed and again whenever its settings change (it compares
+// them with the ones the plan was made for, once per substep), never per particle. A stage that would do
+// nothing is not run at all: a spring kind with stiffness 0 or no springs, zero wind, a disabled collider,
+// no strain or speed limit. The fast solver compiles one sweep per set of spring kinds, so a skipped kind
+// costs no instruction in the hot loop (src/core/grid_solver.cpp). Gravity and damping are coefficients of
+// the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
+#pragma once
+
+#include "clothsim/settings.hpp"
+#include "clothsim/state.hpp"
+#include "clothsim/step_profile.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+// How a substep advances the cloth.
+enum class StepPath {
+    FastSweep,          // Verlet in the fast grid solver: springs, integration fused row by row
+    Textbook,           // Verlet over the spring list, then over the particles
+    VelocityIntegrator, // symplectic Euler, RK4, implicit Euler or XPBD
+};
+
+struct StepPlan {
+    StepPath path = StepPath::Textbook;
+    std::array<bool, kSpringKindCount> springs{};  // a kind runs: it has springs and a non-zero stiffness
+    bool wind = false;
+    bool sphere = false, cube = false, ground = false;
+    bool strain_limit = false;
+    bool speed_limit = false;
+    bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth
+
+    bool any_springs() const { return springs[0] || springs[1] || springs[2]; }
+    bool any_collider() const { return sphere || cube || ground; }
+    // Bit k set when spring kind k runs: the fast solver's sweep variant.
+    unsigned spring_mask() const { return (springs[0] ? 1u : 0u) | (springs[1] ? 2u : 0u) | (springs[2] ? 4u : 0u); }
+};
+
+// `fast_solver` says whether the fast grid solver can run this topology.
+StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver);
+
+// Whether the wind stage exerts any force: air moving, or the uniform model's drag on a moving cloth.
+bool wind_active(const ForceSettings& forces);
+
+// One line per stage for the panel and the JSON: does it run under this plan, and if not (or only in part),
+// why. The reasons quote the setting that decided it.
+struct StageStatus {
+    Stage stage;
+    bool runs;
+    std::string note;  // why it is skipped, or what it covers ("structural, shear; bending: stiffness 0")
+};
+std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings);
+
+}  // namespace clothsim

@@ -1,0 +1,75 @@
+// StepProfile: where the time of a step goes, stage by stage (like Box2D's b2Profile).
+//
+// MassSpring::step() times each stage it runs with the steady clock and adds it here; a stage the plan
+// skips (step_plan.hpp) is not timed at all and shows 0 with the plan's reason. The app reads the profile
+// every frame and resets it; `clothsim --headless --json` reports the totals of the run.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <string_view>
+
+namespace clothsim {
+
+enum class Stage {
+    Springs,     // spring forces (textbook solver and velocity integrators)
+    Wind,        // wind forces
+    Sweep,       // fast solver: springs, gravity, damping and the Verlet update, fused row by row
+    Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
+    Sphere,      // sphere collisions (broad and narrow phase)
+    Cube,        // cube collisions
+    Ground,      // ground collisions
+    StrainLimit, // Provot's strain limit
+    SpeedLimit,  // the max_speed clamp
+    Sleep,       // the once-per-step check of whether the cloth may sleep
+    Count,
+};
+inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count);
+
+// Lower-case names, as the panel and the JSON show them.
+std::string_view stage_name(Stage stage);
+
+struct StepProfile {
+    std::array<double, kStageCount> ms{};         // wall time spent in each stage
+    std::array<long long, kStageCount> runs{};    // substeps (or steps, for Sleep) that ran the stage
+    // Collision broad phase, per collider (sphere, cube, ground): particle blocks whose box met the collider
+    // and were tested particle by particle, out of all blocks offered to it.
+    std::array<long long, 3> blocks_tested{};
+    std::array<long long, 3> blocks_offered{};
+    long long substeps = 0;         // substeps stepped
+    long long slept_substeps = 0;   // substeps skipped because the cloth was asleep
+
+    double total_ms() const {
+        double t = 0.0;
+        for (double v : ms) t += v;
+        return t;
+    }
+    double& ms_of(Stage s) { return ms[static_cast<std::size_t>(s)]; }
+    double ms_of(Stage s) const { return ms[static_cast<std::size_t>(s)]; }
+    long long runs_of(Stage s) const { return runs[static_cast<std::size_t>(s)]; }
+    void add(const StepProfile& other);
+};
+
+// Times one stage into a profile (or nothing, for a null profile) from construction to destruction.
+class StageTimer {
+public:
+    StageTimer(StepProfile* profile, Stage stage)
+        : profile_(profile), stage_(stage), start_(profile ? Clock::now() : Clock::time_point{}) {}
+    ~StageTimer() {
+        if (!profile_) return;
+        const auto i = static_cast<std::size_t>(stage_);
+        profile_->ms[i] += std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
+        ++profile_->runs[i];
+    }
+    StageTimer(const StageTimer&) = delete;
+    StageTimer& operator=(const StageTimer&) = delete;
+
+private:
+    using Clock = std::chrono::steady_clock;
+    StepProfile* profile_;
+    Stage stage_;
+    Clock::time_point start_;
+};
+
+}  // namespace clothsim

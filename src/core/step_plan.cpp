@@ -1,0 +1,103 @@
+#include "clothsim/step_plan.hpp"
+
+namespace clothsim {
+
+std::string_view stage_name(Stage stage) {
+    switch (stage) {
+        case Stage::Springs: return "springs";
+        case Stage::Wind: return "wind";
+        case Stage::Sweep: return "sweep";
+        case Stage::Integrate: return "integrate";
+        case Stage::Sphere: return "sphere";
+        case Stage::Cube: return "cube";
+        case Stage::Ground: return "ground";
+        case Stage::StrainLimit: return "strain limit";
+        case Stage::SpeedLimit: return "speed limit";
+        case Stage::Sleep: return "sleep check";
+        case Stage::Count: break;
+    }
+    return "?";
+}
+
+void StepProfile::add(const StepProfile& other) {
+    for (std::size_t i = 0; i < kStageCount; ++i) {
+        ms[i] += other.ms[i];
+        runs[i] += other.runs[i];
+    }
+    for (std::size_t i = 0; i < 3; ++i) {
+        blocks_tested[i] += other.blocks_tested[i];
+        blocks_offered[i] += other.blocks_offered[i];
+    }
+    substeps += other.substeps;
+    slept_substeps += other.slept_substeps;
+}
+
+bool wind_active(const ForceSettings& forces) {
+    return forces.wind != glm::vec3(0.0f) || forces.wind_model == WindModel::Uniform;
+}
+
+StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver) {
+    StepPlan plan;
+    if (settings.integration.integrator != Integrator::Verlet) {
+        plan.path = StepPath::VelocityIntegrator;
+    } else {
+        plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::FastSweep
+                                                                                 : StepPath::Textbook;
+    }
+    const float k[kSpringKindCount] = {settings.springs.structural, settings.springs.shear, settings.springs.bending};
+    for (int kind = 0; kind < kSpringKindCount; ++kind) {
+        plan.springs[kind] = k[kind] != 0.0f && topology.spring_count_by_kind[kind] > 0;
+    }
+    plan.wind = wind_active(settings.forces);
+    plan.sphere = settings.colliders.sphere.enabled;
+    plan.cube = settings.colliders.cube.enabled;
+    plan.ground = settings.colliders.ground.enabled;
+    plan.strain_limit = settings.springs.strain_limit > 0.0f;
+    plan.speed_limit = settings.forces.max_speed > 0.0f;
+    plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
+    return plan;
+}
+
+namespace {
+
+std::string spring_note(const StepPlan& plan, const Topology& topology) {
+    std::string runs, skipped;
+    for (int kind = 0; kind < kSpringKindCount; ++kind) {
+        const std::string name = to_string(static_cast<SpringKind>(kind));
+        if (plan.springs[kind]) {
+            runs.append(runs.empty() ? "" : ", ").append(name);
+        } else {
+            skipped.append(skipped.empty() ? "" : "; ").append(name).append(
+                topology.spring_count_by_kind[kind] == 0 ? ": no springs" : ": stiffness 0");
+        }
+    }
+    if (runs.empty()) runs = "no spring kind";
+    return skipped.empty() ? runs : runs.append(" (skipped ").append(skipped).append(")");
+}
+
+}  // namespace
+
+std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings) {
+    std::vector<StageStatus> out;
+    const bool fast = plan.path == StepPath::FastSweep;
+    const bool velocity = plan.path == StepPath::VelocityIntegrator;
+    const std::string springs = spring_note(plan, topology);
+    out.push_back({Stage::Springs, !fast && plan.any_springs(), fast ? "fused into the sweep" : springs});
+    out.push_back({Stage::Wind, plan.wind, plan.wind ? "" : "forces.wind is 0"});
+    out.push_back({Stage::Sweep, fast,
+                   fast ? springs + ", gravity, damping, Verlet"
+                        : (velocity ? "the integrator is not Verlet" : "solver.method is textbook (or no grid)")});
+    out.push_back({Stage::Integrate, !fast, fast ? "fused into the sweep" : ""});
+    const char* culled = settings.solver.broad_phase ? "blocks whose bounds meet it" : "every particle (broad phase off)";
+    out.push_back({Stage::Sphere, plan.sphere, plan.sphere ? culled : "disabled"});
+    out.push_back({Stage::Cube, plan.cube, plan.cube ? culled : "disabled"});
+    out.push_back({Stage::Ground, plan.ground, plan.ground ? culled : "disabled"});
+    out.push_back({Stage::StrainLimit, plan.strain_limit, plan.strain_limit ? "" : "springs.strain_limit is 0"});
+    out.push_back({Stage::SpeedLimit, plan.speed_limit, plan.speed_limit ? "" : "forces.max_speed is 0"});
+    out.push_back({Stage::Sleep, plan.may_sleep,
+                   plan.may_sleep ? "" : (settings.solver.sleep_speed > 0.0f ? "forces.wind keeps it awake"
+                                                                             : "solver.sleep_speed is 0")});
+    return out;
+}
+
+}  // namespace clothsim

@@ -3,6 +3,7 @@
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
+#include "skipping.hpp"
 #include "stability_sweep.hpp"
 #include "work_precision.hpp"
 
@@ -109,6 +110,13 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     stability->add_option("--csv", st.csv, "Write the sweep as CSV");
     stability->add_option("--plot", st.plot, "Write the measured-against-predicted PNG (needs --csv; gnuplot)");
+    bench::SkippingOptions sk;
+    CLI::App* skipping = app.add_subcommand(
+        "skipping", "What unneeded stages cost: far collider, zero stiffness, sleeping, broad phase (docs/PERFORMANCE.md)");
+    skipping->add_option("--sizes", sk.sizes, "Grid sizes of the hanging cases")->delimiter(',');
+    skipping->add_option("--repeats", sk.repeats, "Interleaved repetitions (medians)")->check(CLI::Range(1, 1000));
+    skipping->add_option("--min-seconds", sk.min_seconds, "Minimum length of one repetition")->check(CLI::PositiveNumber);
+    skipping->add_option("--csv", sk.csv, "Write the table as CSV");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -116,6 +124,7 @@ int main(int argc, char** argv) {
     }
     if (*work_precision) return bench::run_work_precision(wp);
     if (*stability) return bench::run_stability(st);
+    if (*skipping) return bench::run_skipping(sk);
 
     std::vector<Row> rows;
     try {

@@ -1,6 +1,6 @@
-// Broad phase of the collision stage: axis-aligned boxes around blocks of consecutive particles (a grid row
-// in the fast solver, kBlockParticles otherwise), and conservative tests of whether a collider can touch
-// anything in a box. A collider is then tested particle by particle only on the blocks it may touch; a
+// Broad phase of the collision stage: axis-aligned boxes around blocks of consecutive particles (runs of at
+// most kBlockParticles along a grid row, so a block is a short piece of cloth; runs of the particle list
+// otherwise), and conservative tests of whether a collider can touch anything in a box. A collider is then tested particle by particle only on the blocks it may touch; a
 // collider out of reach of every block costs one box test per block.
 //
 // The tests are conservative: every particle whose contact depth (colliders.hpp) is positive lies in a box
@@ -14,10 +14,13 @@
 
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
 namespace clothsim {
 
-inline constexpr std::size_t kBlockParticles = 64;  // block size when the particles are not a grid
+// Particles per block. Smaller blocks cull more of a cloth draped over a collider, larger ones cost fewer box
+// tests; 16 is two AVX2 vectors (docs/PERFORMANCE.md has the drape figures).
+inline constexpr std::size_t kBlockParticles = 16;
 
 struct Box {
     glm::vec3 lo{INFINITY};
@@ -27,6 +30,15 @@ struct Box {
 
 // The box around particles [begin, end); NaN coordinates are left out (a NaN particle touches nothing).
 Box particle_bounds(const Vec3Array& position, std::size_t begin, std::size_t end);
+
+// The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles.
+void row_block_bounds(const Vec3Array& position, std::size_t begin, std::size_t count, Box* out);
+
+// Block k holds particles [start[k], start[k + 1]). For a rows x cols grid (rows * cols == particles) the
+// blocks are runs of at most kBlockParticles along each row, in row order: row r's j-th run is block
+// r * blocks_per_row(cols) + j, the layout the fast solver fills its boxes in.
+std::vector<std::size_t> block_starts(std::size_t particles, int rows, int cols);
+inline std::size_t blocks_per_row(int cols) { return (static_cast<std::size_t>(cols) + kBlockParticles - 1) / kBlockParticles; }
 
 // Whether a particle in `box` can come closer than `thickness` to the collider's surface.
 bool may_touch(const SphereCollider& sphere, float thickness, const Box& box);

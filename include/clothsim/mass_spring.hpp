@@ -7,11 +7,13 @@
 // Topology is fixed at construction; SimulationSettings may be edited between steps (stiffness, damping,
 // forces, colliders, dt, substeps) and take effect at the next step.
 //
-// Sleeping (as Box2D's islands sleep): when solver.sleep_speed > 0, the air is still, and at the end of
-// every step for solver.sleep_time seconds each free particle moved less than sleep_speed x substep in the
-// substep, the cloth falls asleep: its motion is set to zero and substeps only advance the clock. Any
-// change of the settings (a collider moved, wind, a slider), a pin set or moved (a grab), or set_particle()
-// wakes it, and it restarts from rest.
+// Sleeping (as Box2D's islands sleep): when solver.sleep_speed > 0 and the air is still, the cloth is
+// checked at the end of every step: each free particle's displacement since the last check, over the time
+// between, is its speed. Once every speed has stayed under sleep_speed for solver.sleep_time seconds (and no
+// particle's substep motion exceeded 100 x sleep_speed x substep, so a vibration cannot hide between
+// checks), the cloth falls asleep: its motion is set to zero and substeps only advance the clock. Any change
+// of the settings (a collider moved, wind, a slider), a pin set or moved (a grab), or set_particle() wakes
+// it, and it restarts from rest.
 #pragma once
 
 #include "clothsim/particle.hpp"
@@ -98,6 +100,8 @@ public:
     void set_profiling(bool on) { profiling_ = on; }
 
     bool asleep() const { return asleep_; }
+    // s: how long the cloth has stayed under sleep_speed (it sleeps at solver.sleep_time).
+    double calm_seconds() const { return calm_seconds_; }
     // Asleep with no settings change waiting to wake it: the next step will not move anything.
     bool resting() const { return asleep_ && settings_ == planned_; }
     // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
@@ -158,6 +162,8 @@ private:
     int last_iterations_ = 0;
     bool asleep_ = false;
     double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
+    Vec3Array sleep_reference_;  // m: positions at the last sleep check (empty: none since waking)
+    double sleep_reference_time_ = 0.0;
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;
 };

@@ -46,13 +46,17 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
 // Whether the wind stage exerts any force: air moving, or the uniform model's drag on a moving cloth.
 bool wind_active(const ForceSettings& forces);
 
-// One line per stage for the panel and the JSON: does it run under this plan, and if not (or only in part),
-// why. The reasons quote the setting that decided it.
+// One line per stage for the panel and the JSON: does it run under this plan as a timed stage of its own,
+// is its work done (and timed) inside another stage, or is it skipped, and why. The reasons quote the
+// setting that decided it.
+enum class StageState { Runs, Fused, Skipped };
 struct StageStatus {
     Stage stage;
-    bool runs;
-    std::string note;  // why it is skipped, or what it covers ("structural, shear; bending: stiffness 0")
+    StageState state;
+    std::string note;  // why it is skipped, where it is fused, or what it covers
+    bool runs() const { return state == StageState::Runs; }
 };
+std::string_view state_name(StageState state);  // "runs", "fused", "skipped"
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings);
 
 }  // namespace clothsim

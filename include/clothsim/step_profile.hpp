@@ -17,6 +17,7 @@ enum class Stage {
     Wind,        // wind forces
     Sweep,       // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
+    BroadPhase,  // boxes of the particle blocks (when the sweep did not leave them) and of the whole cloth
     Sphere,      // sphere collisions (broad and narrow phase)
     Cube,        // cube collisions
     Ground,      // ground collisions
@@ -32,7 +33,8 @@ std::string_view stage_name(Stage stage);
 
 struct StepProfile {
     std::array<double, kStageCount> ms{};         // wall time spent in each stage
-    std::array<long long, kStageCount> runs{};    // substeps (or steps, for Sleep) that ran the stage
+    std::array<long long, kStageCount> runs{};    // times the stage ran: once a substep (colliders twice when a
+                                                  // strain or speed limit runs; Sleep once a step)
     // Collision broad phase, per collider (sphere, cube, ground): particle blocks whose box met the collider
     // and were tested particle by particle, out of all blocks offered to it.
     std::array<long long, 3> blocks_tested{};

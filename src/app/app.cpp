@@ -95,7 +95,8 @@ bool rebuild(AppState& app, Renderer& renderer) {
 // max_catchup_steps per frame so a slow frame slows the simulation instead of spiralling.
 void simulate(AppState& app, double wall_seconds, bool scripted) {
     app.sim.settings() = app.scene.settings;
-    app.limit = stability_limit(app.sim);
+    // The limit depends on the settings, masses and pins: a resting cloth has had none of them change.
+    if (!app.sim.resting()) app.limit = stability_limit(app.sim);
     if (app.auto_substeps) {
         const int n = auto_substeps(app.limit, app.scene.settings.integration.dt, app.safety);
         app.scene.settings.integration.substeps = n;
@@ -120,7 +121,9 @@ void simulate(AppState& app, double wall_seconds, bool scripted) {
     }
     app.step_once = false;
     const auto start = Clock::now();
-    if (steps > 0 && app.sim.all_finite()) {
+    app.sim.reset_profile();
+    const bool was_resting = app.sim.resting();
+    if (steps > 0 && (was_resting || app.sim.all_finite())) {
         // The guard: a step that blows up is rolled back and retried with twice the substeps; the user is told.
         std::string log;
         const bool ok = run_guarded(app.sim, steps, GuardSettings{}, log);
@@ -136,8 +139,16 @@ void simulate(AppState& app, double wall_seconds, bool scripted) {
             app.paused = true;
             app.say(log + "paused at the last good state: lower integration.dt or soften the springs, then play", true);
         }
-        record_energy(app);
+        if (was_resting && app.sim.resting()) {
+            // Nothing moved: the plots go on with the same values instead of recomputing them.
+            app.stats.kinetic.push(app.stats.kinetic.last());
+            app.stats.potential.push(app.stats.potential.last());
+            app.stats.total.push(app.stats.total.last());
+        } else {
+            record_energy(app);
+        }
     }
+    app.stats.profile = app.sim.profile();
     app.stats.sim_ms = std::chrono::duration<float, std::milli>(Clock::now() - start).count();
     app.stats.substeps_last_frame = steps * app.scene.settings.integration.substeps;
 }
@@ -403,6 +414,9 @@ int run_app(const Scene& scene, const AppOptions& options) {
         const float to_pixels = float(fb.x) / float(std::max(window->window_size().x, 1));
         const glm::ivec4 viewport(glm::round(rect.x * to_pixels), 0, glm::round(rect.z * to_pixels), fb.y);
         renderer->draw({app.sim, app.camera, fb, viewport, app.view, grabbed});
+        const Renderer::ClothTimings& cloth = renderer->cloth_timings();
+        app.stats.cloth_uploaded = cloth.cloth_uploaded;
+        app.stats.times.add_frame(app.stats.profile, cloth.normals_ms, cloth.upload_ms);
         if (app.show_panel) {
             PanelRequests panel = draw_panel(app, scale);
             requests.rebuild |= panel.rebuild;

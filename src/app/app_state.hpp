@@ -35,12 +35,29 @@ struct History {
     float last() const { return count ? values[(next + kLength - 1) % kLength] : 0.0f; }
 };
 
+// Per-stage milliseconds per frame, smoothed over about ten frames so the panel's figures can be read.
+struct StageTimes {
+    static constexpr float kSmoothing = 0.1f;
+    std::array<float, kStageCount> stage_ms{};
+    float normals_ms = 0.0f, upload_ms = 0.0f;
+    void add_frame(const StepProfile& frame, float normals, float upload) {
+        for (std::size_t i = 0; i < kStageCount; ++i) {
+            stage_ms[i] += kSmoothing * (static_cast<float>(frame.ms[i]) - stage_ms[i]);
+        }
+        normals_ms += kSmoothing * (normals - normals_ms);
+        upload_ms += kSmoothing * (upload - upload_ms);
+    }
+};
+
 struct Stats {
     float sim_ms = 0.0f;     // wall time of this frame's physics
     float render_ms = 0.0f;  // CPU time to issue this frame's drawing (scene and panel)
     long long substeps_last_frame = 0;
     double dropped_seconds = 0.0;  // simulated time skipped because frames were too slow to catch up
     History kinetic, potential, total;
+    StepProfile profile;     // this frame's stages (MassSpring::profile, reset every frame)
+    StageTimes times;
+    bool cloth_uploaded = false;  // the renderer uploaded positions and normals this frame
 };
 
 // A particle held with the mouse: pinned while held and moved in the plane facing the camera.

@@ -3,6 +3,7 @@
 #include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
+#include "clothsim/step_plan.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -12,6 +13,8 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace clothsim {
 namespace {
@@ -19,6 +22,56 @@ namespace {
 bool parent_exists(const std::string& path) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     return parent.empty() || std::filesystem::is_directory(parent);
+}
+
+
+// The run's step profile: every stage of the plan with its time (total and per step) or why it was skipped.
+nlohmann::json profile_json(const StepProfile& p, const std::vector<StageStatus>& stages, long long steps, bool asleep) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const StageStatus& s : stages) {
+        const std::size_t i = static_cast<std::size_t>(s.stage);
+        nlohmann::json stage = {{"stage", std::string(stage_name(s.stage))},
+                                {"state", std::string(state_name(s.state))},
+                                {"ms", p.ms[i]},
+                                {"ms_per_step", steps > 0 ? p.ms[i] / double(steps) : 0.0},
+                                {"substeps_run", p.runs[i]},
+                                {"note", s.note}};
+        if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
+            const std::size_t c = i - static_cast<std::size_t>(Stage::Sphere);
+            stage["blocks_tested"] = p.blocks_tested[c];
+            stage["blocks_offered"] = p.blocks_offered[c];
+        }
+        list.push_back(stage);
+    }
+    return {{"stages", list},
+            {"total_ms", p.total_ms()},
+            {"substeps", p.substeps},
+            {"slept_substeps", p.slept_substeps},
+            {"asleep_at_end", asleep}};
+}
+
+void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages, long long steps, bool asleep) {
+    std::printf("stages, ms per step:");
+    std::string skipped, fused;
+    for (const StageStatus& s : stages) {
+        const std::size_t i = static_cast<std::size_t>(s.stage);
+        if (s.runs()) {
+            std::printf(" %s %.4f", std::string(stage_name(s.stage)).c_str(), steps > 0 ? p.ms[i] / double(steps) : 0.0);
+            if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
+                const std::size_t c = i - static_cast<std::size_t>(Stage::Sphere);
+                std::printf(" (%lld of %lld blocks tested)", p.blocks_tested[c], p.blocks_offered[c]);
+            }
+            std::printf(";");
+        } else {
+            std::string& list = s.state == StageState::Skipped ? skipped : fused;
+            list.append(list.empty() ? "" : "; ").append(stage_name(s.stage)).append(" (").append(s.note).append(")");
+        }
+    }
+    std::printf("\nfused: %s\nskipped: %s\n", fused.c_str(), skipped.c_str());
+    if (p.slept_substeps > 0 || asleep) {
+        std::printf("asleep for %lld of %lld substeps%s\n", p.slept_substeps, p.slept_substeps + p.substeps,
+                    asleep ? " (asleep at the end)" : "");
+    }
 }
 
 }  // namespace
@@ -98,6 +151,8 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
     }
 
     const Energy e = sim.energy();
+    const StepProfile& profile = sim.profile();
+    const std::vector<StageStatus> stages = describe(sim.plan(), sim.topology(), sim.settings());
     const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
     if (options.json) {
         nlohmann::json out = {
@@ -118,6 +173,7 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
             {"kinetic_energy", finite_or_null(e.kinetic)},
             {"potential_energy", finite_or_null(e.potential())},
             {"total_energy", finite_or_null(e.total())},
+            {"profile", profile_json(profile, stages, done, sim.asleep())},
         };
         std::cout << out.dump(2) << std::endl;
     } else {
@@ -127,6 +183,7 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
                     sim.settings().integration.substeps, sim.time(), wall);
         std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
                     e.total(), finite ? "yes" : "no");
+        print_profile(profile, stages, done, sim.asleep());
     }
     return code;
 }

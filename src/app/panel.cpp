@@ -34,7 +34,8 @@ constexpr SliderHint kHints[] = {
     {"forces.drag", 0.0f, 10.0f, true},       {"cloth.mass", 0.001f, 100.0f, true},
     {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
     {"integration.tolerance", 1e-10f, 1e-2f, true}, {"springs.strain_limit", 0.0f, 1.0f, false},
-    {"forces.max_speed", 0.0f, 100.0f, false},
+    {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
+    {"solver.sleep_time", 0.0f, 10.0f, false},
 };
 
 const SliderHint* hint_for(std::string_view name) {
@@ -200,6 +201,66 @@ void plot(const char* label, const History& h, ImVec4 color) {
     ImGui::PlotLines("##energy", h.values.data(), h.size(), h.offset(), overlay, FLT_MAX, FLT_MAX,
                      ImVec2(ImGui::GetContentRegionAvail().x, 3.5f * ImGui::GetFontSize()));
     ImGui::PopStyleColor();
+}
+
+// Box2D-style step profile: every stage of the plan, its time per frame, and why a skipped one is skipped.
+void profile_section(const AppState& app) {
+    const StepProfile& frame = app.stats.profile;
+    const SimulationSettings& settings = app.sim.settings();
+    const ImVec4 grey(0.55f, 0.55f, 0.55f, 1.0f);
+    if (app.sim.asleep()) {
+        ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1.0f), "asleep: %lld substeps skipped this frame", frame.slept_substeps);
+    } else if (app.sim.plan().may_sleep) {
+        ImGui::Text("awake: calm for %.2f of %.2f s before sleeping", app.sim.calm_seconds(), settings.solver.sleep_time);
+    } else {
+        ImGui::TextDisabled("awake: sleeping is off (%s)",
+                            settings.solver.sleep_speed > 0.0f ? "forces.wind blows" : "solver.sleep_speed is 0");
+    }
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("The cloth sleeps once every free particle has moved slower than solver.sleep_speed\n"
+                          "for solver.sleep_time with still air; any setting change, a grab or a pin wakes it.");
+    }
+    const ImGuiTableFlags flags = ImGuiTableFlags_SizingStretchProp | ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV;
+    if (!ImGui::BeginTable("stages", 3, flags)) return;
+    ImGui::TableSetupColumn("stage", ImGuiTableColumnFlags_WidthFixed);
+    ImGui::TableSetupColumn("ms/frame", ImGuiTableColumnFlags_WidthFixed);
+    ImGui::TableSetupColumn("runs / why not");
+    ImGui::TableHeadersRow();
+    auto row = [&](std::string_view name, StageState state, float ms, const std::string& note) {
+        const bool runs = state == StageState::Runs;
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        if (runs) ImGui::TextUnformatted(name.data(), name.data() + name.size());
+        else ImGui::TextColored(grey, "%.*s", static_cast<int>(name.size()), name.data());
+        ImGui::TableNextColumn();
+        if (runs) ImGui::Text("%.3f", ms);
+        else ImGui::TextColored(grey, "-");
+        ImGui::TableNextColumn();
+        if (runs) ImGui::TextUnformatted(note.c_str());
+        else if (state == StageState::Fused) ImGui::TextColored(grey, "%s", note.c_str());
+        else ImGui::TextColored(grey, "skipped: %s", note.c_str());
+        if (!note.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", note.c_str());
+    };
+    float total = 0.0f;
+    for (const StageStatus& s : describe(app.sim.plan(), app.sim.topology(), settings)) {
+        const std::size_t i = static_cast<std::size_t>(s.stage);
+        std::string note = s.note;
+        if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
+            const std::size_t c = static_cast<std::size_t>(s.stage) - static_cast<std::size_t>(Stage::Sphere);
+            if (s.runs() && frame.blocks_offered[c] > 0) {
+                note = std::to_string(frame.blocks_tested[c]) + " of " + std::to_string(frame.blocks_offered[c]) +
+                       " blocks tested";
+            }
+        }
+        total += app.stats.times.stage_ms[i];
+        row(stage_name(s.stage), s.state, app.stats.times.stage_ms[i], note);
+    }
+    const bool moved = app.stats.cloth_uploaded;
+    const StageState drawn = moved ? StageState::Runs : StageState::Skipped;
+    row("normals", drawn, app.stats.times.normals_ms, moved ? "renderer" : "nothing moved");
+    row("upload", drawn, app.stats.times.upload_ms, moved ? "positions and normals to the GPU" : "nothing moved");
+    ImGui::EndTable();
+    ImGui::Text("stages %.3f ms per frame (smoothed over ~10 frames)", total);
 }
 
 void help_section() {
@@ -414,6 +475,7 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
         plot("potential", app.stats.potential, ImVec4(0.4f, 0.7f, 1.0f, 1.0f));
         plot("total", app.stats.total, ImVec4(0.9f, 0.9f, 0.9f, 1.0f));
     }
+    if (ImGui::CollapsingHeader("Profile", ImGuiTreeNodeFlags_DefaultOpen)) profile_section(app);
     if (ImGui::CollapsingHeader("Help")) help_section();
     ImGui::PopItemWidth();
     ImGui::End();

@@ -20,11 +20,17 @@ struct Contact {
 template <class T>
 Contact<T> contact(const SphereCollider& sphere, glm::vec<3, T> p, T thickness) {
     const glm::vec<3, T> d = p - glm::vec<3, T>(sphere.center);
-    const T length = glm::length(d);
     Contact<T> c;
+    const T reach = T(sphere.radius) + thickness;
+    // Clearly outside (by a relative 1e-5, far beyond sqrt's rounding): no contact, no square root.
+    if (glm::dot(d, d) > reach * reach * T(1.00001)) {
+        c.depth = T(-1);
+        return c;
+    }
+    const T length = glm::length(d);
     // A particle exactly at the centre has no direction: push it straight up.
     if (length > T(1e-12f)) c.normal = d / length;
-    c.depth = T(sphere.radius) + thickness - length;
+    c.depth = reach - length;
     return c;
 }
 
@@ -56,17 +62,19 @@ Contact<T> contact(const GroundCollider& ground, glm::vec<3, T> p, T thickness) 
     return {glm::vec<3, T>(T(0), T(1), T(0)), T(ground.height) + thickness - p.y};
 }
 
-// Returns whether it moved a particle. A NaN position has NaN depth and is left alone (the guard reports it).
+// Returns a bound on how far it moved any particle: each push is at most depth (1 + friction) long (the normal
+// push plus a friction cut of at most friction x depth). A NaN position has NaN depth and is left alone (the
+// guard reports it).
 template <class T, class Shape>
-bool collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
-                   std::size_t end) {
+T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
+                std::size_t end) {
     using Vec = glm::vec<3, T>;
-    bool moved = false;
+    T deepest = T(0);
     for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
         const Contact<T> c = contact(shape, state.position.get(i), thickness);
         if (!(c.depth > T(0))) continue;
-        moved = true;
+        deepest = std::max(deepest, c.depth);
         const Vec motion = state.motion.get(i);
         const T normal_motion = glm::dot(motion, c.normal);
         const Vec tangential = motion - normal_motion * c.normal;
@@ -79,25 +87,35 @@ bool collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thick
         // velocity of depth / h: a cloth started half inside the sphere exploded that way.
         state.motion.set(i, tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal);
     }
-    return moved;
+    return deepest * (T(1) + friction);
 }
 
 template <class Shape>
 void collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
                     std::size_t which, StepProfile* profile) {
-    const std::size_t n = state.size(), size = blocks.size;
     long long tested = 0;
-    for (std::size_t k = 0, begin = 0; begin < n; ++k, begin += size) {
-        const std::size_t end = std::min(n, begin + size);
+    // First the whole cloth: a collider out of its reach costs this one test.
+    const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
+    for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
+        const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
         ++tested;
-        if (collide_shape(state, shape, shape.friction, thickness, begin, end) && broad_phase) {
-            blocks.boxes[k] = particle_bounds(state.position, begin, end);
+        const float moved = collide_shape(state, shape, shape.friction, thickness, begin, end);
+        if (moved > 0.0f && broad_phase) {
+            // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
+            // conservative for the next collider, and O(1).
+            Box& box = blocks.boxes[k];
+            const glm::vec3 far = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+            const glm::vec3 grow(moved * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::max({far.x, far.y, far.z})));
+            box.lo -= grow;
+            box.hi += grow;
+            blocks.cloth.lo = glm::min(blocks.cloth.lo, box.lo);  // grows only: stays conservative
+            blocks.cloth.hi = glm::max(blocks.cloth.hi, box.hi);
         }
     }
     if (profile) {
         profile->blocks_tested[which] += tested;
-        profile->blocks_offered[which] += static_cast<long long>(blocks.boxes.size());
+        profile->blocks_offered[which] += static_cast<long long>(blocks.count());
     }
 }
 
@@ -124,38 +142,42 @@ void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::s
 }
 void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile) {
-    const std::size_t n = state.size(), size = std::max<std::size_t>(blocks.size, 1);
-    blocks.size = size;
-    const std::size_t count = (n + size - 1) / size;
+    if (blocks.start.empty() || blocks.start.back() != state.size()) {
+        blocks.start = block_starts(state.size(), 0, 0);
+        blocks.current = blocks.boxes_current = false;
+    }
+    const std::size_t count = blocks.count();
     const bool any = colliders.sphere.enabled || colliders.cube.enabled || colliders.ground.enabled;
     if (!any) return;
-    auto prepare = [&] {  // timed with the first collider that runs
-        if (!broad_phase) {
-            blocks.boxes.resize(count);  // only counted: every block is tested
-            blocks.current = false;
-            return;
+    if (!broad_phase) {
+        blocks.boxes.resize(count);  // only counted: every block is tested
+        blocks.current = blocks.boxes_current = false;
+    } else if (!(blocks.current && blocks.boxes.size() == count)) {
+        StageTimer timer(profile, Stage::BroadPhase);
+        if (!(blocks.boxes_current && blocks.boxes.size() == count)) {
+            blocks.boxes.resize(count);
+            for (std::size_t k = 0; k < count; ++k) {
+                blocks.boxes[k] = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
+            }
         }
-        if (blocks.current && blocks.boxes.size() == count) return;
-        blocks.boxes.resize(count);
-        for (std::size_t k = 0; k < count; ++k) {
-            blocks.boxes[k] = particle_bounds(state.position, k * size, std::min(n, (k + 1) * size));
+        blocks.cloth = Box{};
+        for (const Box& b : blocks.boxes) {
+            blocks.cloth.lo = glm::min(blocks.cloth.lo, b.lo);
+            blocks.cloth.hi = glm::max(blocks.cloth.hi, b.hi);
         }
-        blocks.current = true;
-    };
+        blocks.boxes_current = blocks.current = true;
+    }
     const float thickness = colliders.thickness;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        prepare();
         collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, 0, profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        prepare();
         collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, 1, profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        prepare();
         collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, 2, profile);
     }
 }

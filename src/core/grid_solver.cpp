@@ -165,7 +165,7 @@ void GridSolver::step(State& state, const SimulationSettings& settings, unsigned
             boundary_slot_[begin - 1] = 2 * b + 1;
         }
     }
-    if (row_boxes) row_boxes->resize(rows_);
+    if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
     const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
     auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
     if (blocks == 1) {
@@ -292,7 +292,7 @@ struct SweepInput {
     const SimulationSettings& settings;
     const Vec3Array* external;
     float h;
-    Box* row_boxes;  // the box of each row after its update, or null when no collider runs
+    Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
     float* window;
     const float* zeros;
 };
@@ -337,8 +337,10 @@ template <bool Avx2, unsigned Mask>
                                            position[comp], motion[comp], w, grid.cols, stride, gravity[comp], keep, h2);
             }
         }
-        // The row is still in L1: its box for the collision broad phase costs one more pass over it.
-        if (in.row_boxes) in.row_boxes[r] = particle_bounds(state.position, i0, i0 + grid.cols);
+        // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
+        if (in.row_boxes) {
+            row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
+        }
     }
 }
 

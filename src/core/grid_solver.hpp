@@ -33,7 +33,8 @@ public:
 
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
-    // caller's next stage; for it, `row_boxes` (when not null) receives each row's box after the update.
+    // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
+    // block_starts(rows x cols) after the update.
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
               float h, std::vector<Box>* row_boxes);
 

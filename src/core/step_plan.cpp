@@ -8,6 +8,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Wind: return "wind";
         case Stage::Sweep: return "sweep";
         case Stage::Integrate: return "integrate";
+        case Stage::BroadPhase: return "broad phase";
         case Stage::Sphere: return "sphere";
         case Stage::Cube: return "cube";
         case Stage::Ground: return "ground";
@@ -77,24 +78,54 @@ std::string spring_note(const StepPlan& plan, const Topology& topology) {
 
 }  // namespace
 
+std::string_view state_name(StageState state) {
+    switch (state) {
+        case StageState::Runs: return "runs";
+        case StageState::Fused: return "fused";
+        case StageState::Skipped: return "skipped";
+    }
+    return "?";
+}
+
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings) {
+    using enum StageState;
     std::vector<StageStatus> out;
     const bool fast = plan.path == StepPath::FastSweep;
     const bool velocity = plan.path == StepPath::VelocityIntegrator;
     const std::string springs = spring_note(plan, topology);
-    out.push_back({Stage::Springs, !fast && plan.any_springs(), fast ? "fused into the sweep" : springs});
-    out.push_back({Stage::Wind, plan.wind, plan.wind ? "" : "forces.wind is 0"});
-    out.push_back({Stage::Sweep, fast,
-                   fast ? springs + ", gravity, damping, Verlet"
-                        : (velocity ? "the integrator is not Verlet" : "solver.method is textbook (or no grid)")});
-    out.push_back({Stage::Integrate, !fast, fast ? "fused into the sweep" : ""});
-    const char* culled = settings.solver.broad_phase ? "blocks whose bounds meet it" : "every particle (broad phase off)";
-    out.push_back({Stage::Sphere, plan.sphere, plan.sphere ? culled : "disabled"});
-    out.push_back({Stage::Cube, plan.cube, plan.cube ? culled : "disabled"});
-    out.push_back({Stage::Ground, plan.ground, plan.ground ? culled : "disabled"});
-    out.push_back({Stage::StrainLimit, plan.strain_limit, plan.strain_limit ? "" : "springs.strain_limit is 0"});
-    out.push_back({Stage::SpeedLimit, plan.speed_limit, plan.speed_limit ? "" : "forces.max_speed is 0"});
-    out.push_back({Stage::Sleep, plan.may_sleep,
+    auto when = [](bool runs, StageState otherwise) { return runs ? Runs : otherwise; };
+    if (!plan.any_springs()) {
+        out.push_back({Stage::Springs, Skipped, springs});
+    } else if (fast) {
+        out.push_back({Stage::Springs, Fused, "in the sweep: " + springs});
+    } else if (velocity) {
+        out.push_back({Stage::Springs, Fused, "in the integrate stage (evaluated per force call): " + springs});
+    } else {
+        out.push_back({Stage::Springs, Runs, springs});
+    }
+    if (!plan.wind) {
+        out.push_back({Stage::Wind, Skipped, "forces.wind is 0"});
+    } else {
+        out.push_back({Stage::Wind, velocity ? Fused : Runs, velocity ? "in the integrate stage" : ""});
+    }
+    out.push_back({Stage::Sweep, when(fast, Skipped),
+                   fast ? "springs, gravity, damping and the Verlet update, row by row"
+                        : (velocity ? "the integrator is not verlet" : "solver.method is textbook (or the cloth is no grid)")});
+    out.push_back({Stage::Integrate, fast ? Fused : Runs, fast ? "in the sweep" : ""});
+    if (!plan.any_collider()) {
+        out.push_back({Stage::BroadPhase, Skipped, "no collider is enabled"});
+    } else if (!settings.solver.broad_phase) {
+        out.push_back({Stage::BroadPhase, Skipped, "solver.broad_phase is false"});
+    } else {
+        out.push_back({Stage::BroadPhase, Runs, fast ? "the cloth's box (the sweep boxes the blocks)" : "boxes of the blocks and the cloth"});
+    }
+    const char* culled = settings.solver.broad_phase ? "blocks whose box meets it" : "every particle (broad phase off)";
+    out.push_back({Stage::Sphere, when(plan.sphere, Skipped), plan.sphere ? culled : "colliders.sphere.enabled is false"});
+    out.push_back({Stage::Cube, when(plan.cube, Skipped), plan.cube ? culled : "colliders.cube.enabled is false"});
+    out.push_back({Stage::Ground, when(plan.ground, Skipped), plan.ground ? culled : "colliders.ground.enabled is false"});
+    out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
+    out.push_back({Stage::SpeedLimit, when(plan.speed_limit, Skipped), plan.speed_limit ? "" : "forces.max_speed is 0"});
+    out.push_back({Stage::Sleep, when(plan.may_sleep, Skipped),
                    plan.may_sleep ? "" : (settings.solver.sleep_speed > 0.0f ? "forces.wind keeps it awake"
                                                                              : "solver.sleep_speed is 0")});
     return out;

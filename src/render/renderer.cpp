@@ -7,6 +7,7 @@
 #include <stb_image.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -140,6 +141,7 @@ void Renderer::set_cloth(const MassSpring& sim) {
     for (const auto& tri : t.triangles) data.indices.insert(data.indices.end(), tri.begin(), tri.end());
     cloth_.emplace(data, true);
     cloth_particles_ = sim.particle_count();
+    uploaded_stamp_ = sim.change_stamp();
     // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
     const float width = glm::length(data.positions[t.index(0, t.cols - 1)] - data.positions[0]);
     const float height = glm::length(data.positions[t.index(t.rows - 1, 0)] - data.positions[0]);
@@ -147,10 +149,25 @@ void Renderer::set_cloth(const MassSpring& sim) {
 }
 
 void Renderer::upload_cloth(const MassSpring& sim) {
-    if (!cloth_ || cloth_particles_ != sim.particle_count()) set_cloth(sim);
+    using Clock = std::chrono::steady_clock;
+    cloth_timings_.normals_ms = cloth_timings_.upload_ms = 0.0f;
+    cloth_timings_.cloth_uploaded = false;
+    if (!cloth_ || cloth_particles_ != sim.particle_count()) {
+        set_cloth(sim);
+    } else if (sim.change_stamp() == uploaded_stamp_) {
+        ++cloth_timings_.skipped;  // nothing moved (a sleeping or paused cloth): the GPU has these positions
+        return;
+    }
+    const auto start = Clock::now();
     positions_ = sim.positions();
     compute_vertex_normals(sim.topology(), sim.state().position, normals_);
+    const auto normals_done = Clock::now();
     cloth_->update_positions_normals(positions_, normals_);
+    uploaded_stamp_ = sim.change_stamp();
+    cloth_timings_.normals_ms = std::chrono::duration<float, std::milli>(normals_done - start).count();
+    cloth_timings_.upload_ms = std::chrono::duration<float, std::milli>(Clock::now() - normals_done).count();
+    cloth_timings_.cloth_uploaded = true;
+    ++cloth_timings_.uploads;
 }
 
 void Renderer::draw(const RenderInput& input) {

@@ -12,6 +12,7 @@
 #include <glm/mat4x4.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <vector>
@@ -62,6 +63,18 @@ public:
     void set_cloth(const MassSpring& sim);
     void draw(const RenderInput& input);
 
+    // What the last draw() spent preparing the cloth: vertex normals and the upload of positions and
+    // normals. Both are skipped (and `cloth_uploaded` is false) while the cloth has not moved since the last
+    // upload (MassSpring::change_stamp).
+    struct ClothTimings {
+        float normals_ms = 0.0f;
+        float upload_ms = 0.0f;
+        bool cloth_uploaded = false;
+        long long uploads = 0;  // since the renderer was made
+        long long skipped = 0;
+    };
+    const ClothTimings& cloth_timings() const { return cloth_timings_; }
+
 private:
     void upload_cloth(const MassSpring& sim);
     void draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection);
@@ -82,6 +95,8 @@ private:
     GpuMesh ground_;
     std::optional<GpuMesh> cloth_;
     std::size_t cloth_particles_ = 0;
+    std::uint64_t uploaded_stamp_ = 0;  // the change_stamp of the positions on the GPU (0: none)
+    ClothTimings cloth_timings_;
     glm::vec2 cloth_uv_scale_{1.0f};
     std::vector<glm::vec3> positions_, normals_;
 

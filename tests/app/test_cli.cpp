@@ -17,6 +17,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <sstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -132,6 +133,49 @@ TEST_CASE("cli: a scene given as a path to a .toml file is run") {
     CHECK(j.at("steps") == 10);
     CHECK(j.at("simulated_seconds").get<double>() == Approx(0.1).margin(1e-6));
     CHECK(j.at("substeps_per_step") == 10);
+}
+
+TEST_CASE("cli: --json reports the step profile: every stage, its time, and why a skipped one is skipped") {
+    const RunResult r = run_clothsim({"--headless", "--scene", "drape-sphere", "--steps", "30", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const nlohmann::json p = nlohmann::json::parse(r.out).at("profile");
+    CHECK(p.at("substeps") == 30 * 38);
+    CHECK(p.at("slept_substeps") == 0);
+    std::map<std::string, nlohmann::json> stage;
+    for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
+    CHECK(stage.size() == 11);
+    // drape-sphere: fast sweep, sphere and ground, no wind, no cube, no limits.
+    CHECK(stage.at("sweep").at("state") == "runs");
+    CHECK(stage.at("sweep").at("substeps_run") == 30 * 38);
+    CHECK(stage.at("sweep").at("ms").get<double>() > 0.0);
+    CHECK(stage.at("springs").at("state") == "fused");
+    CHECK(stage.at("sphere").at("state") == "runs");
+    CHECK(stage.at("sphere").at("blocks_offered") == 30 * 38 * 120);  // 40 rows of 3 blocks
+    CHECK(stage.at("sphere").at("blocks_tested").get<long long>() <= 30 * 38 * 120);
+    CHECK(stage.at("ground").at("blocks_tested") == 0);  // the cloth is far above the ground
+    for (const char* skipped : {"wind", "cube", "strain limit", "speed limit"}) {
+        INFO(skipped);
+        CHECK(stage.at(skipped).at("state") == "skipped");
+        CHECK(stage.at(skipped).at("ms") == 0.0);
+        CHECK(stage.at(skipped).at("substeps_run") == 0);
+        CHECK_FALSE(stage.at(skipped).at("note").get<std::string>().empty());
+    }
+    CHECK_THAT(stage.at("wind").at("note").get<std::string>(), Contains("forces.wind"));
+    CHECK_THAT(stage.at("cube").at("note").get<std::string>(), Contains("colliders.cube.enabled"));
+    double sum = 0.0;
+    for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
+    CHECK(p.at("total_ms").get<double>() == Approx(sum));
+}
+
+TEST_CASE("cli: a headless run reports when the cloth slept, and bending 0 as a skipped spring kind") {
+    const RunResult r = run_clothsim({"--headless", "--set", "cloth.rows=8", "--set", "cloth.cols=8", "--set",
+                                      "springs.damping=4", "--set", "springs.bending=0", "--duration", "20"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("stages, ms per step: sweep"));
+    CHECK_THAT(r.out, Contains("bending: stiffness 0"));
+    CHECK_THAT(r.out, Contains("(asleep at the end)"));
 }
 
 TEST_CASE("cli: the text report of a headless run") {

@@ -1,0 +1,332 @@
+// The collision broad phase: boxes around particle blocks, and may_touch, which must be conservative (a
+// particle a collider would move always lies in a box the test accepts), or culling would change results.
+#include "support.hpp"
+
+#include "clothsim/broad_phase.hpp"
+#include "clothsim/colliders.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+using namespace clothsim;
+
+namespace {
+
+// The box of the finite coordinates of particles [begin, end), the plain way.
+Box reference_bounds(const Vec3Array& p, std::size_t begin, std::size_t end) {
+    Box b;
+    for (std::size_t i = begin; i < end; ++i) {
+        const glm::vec3 q = p.get(i);
+        for (int a = 0; a < 3; ++a) {
+            if (std::isnan(q[a])) continue;
+            b.lo[a] = std::min(b.lo[a], q[a]);
+            b.hi[a] = std::max(b.hi[a], q[a]);
+        }
+    }
+    return b;
+}
+
+// Whether the collider moves a lone free particle at p (or changes its motion).
+template <class Collider>
+bool collider_moves(const Collider& collider, float thickness, glm::vec3 p) {
+    State st = test::free_particles({p}, 1.0f);
+    st.motion.set(0, glm::vec3(0.001f, -0.002f, 0.0005f));  // a motion for friction to act on
+    const State before = st;
+    collide(st, collider, thickness, 0, 1);
+    return !(st.position == before.position) || !(st.motion == before.motion);
+}
+
+// A signed offset spread over many magnitudes, to probe both sides of the surface at every scale.
+float offset(std::mt19937& rng) {
+    std::uniform_real_distribution<float> exponent(-9.0f, -0.5f);  // below float spacing too
+    std::bernoulli_distribution sign(0.5);
+    return (sign(rng) ? 1.0f : -1.0f) * std::pow(10.0f, exponent(rng));
+}
+
+float pick_scale(std::mt19937& rng) {
+    constexpr float kScales[] = {0.0f, 1.0f, 30.0f, 1000.0f};
+    return kScales[std::uniform_int_distribution<int>(0, 3)(rng)];
+}
+
+glm::vec3 random_vec(std::mt19937& rng, float half_width) {
+    std::uniform_real_distribution<float> u(-half_width, half_width);
+    return {u(rng), u(rng), u(rng)};
+}
+
+glm::vec3 random_direction(std::mt19937& rng) {
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    glm::vec3 d;
+    do d = {n(rng), n(rng), n(rng)};
+    while (glm::length(d) < 1e-3f);
+    return glm::normalize(d);
+}
+
+// Tallies of a conservativeness run, so that a test that never probes the boundary fails.
+struct Tally {
+    long long rejected = 0, accepted = 0, moved = 0, near_rejected = 0;
+};
+
+// Checks one particle: if its one-point box is rejected, the collider must not move it; then the same for
+// a small box around it (every corner and the centre).
+template <class Collider>
+void check_conservative(const Collider& collider, float thickness, glm::vec3 p, std::mt19937& rng, Tally& tally) {
+    const bool moves = collider_moves(collider, thickness, p);
+    tally.moved += moves;
+    if (may_touch(collider, thickness, Box{p, p})) {
+        ++tally.accepted;
+    } else {
+        ++tally.rejected;
+        tally.near_rejected += std::abs(signed_distance(collider, p) - thickness) < 1e-3f;
+        if (moves) {
+            FAIL_CHECK("rejected particle (" << p.x << ", " << p.y << ", " << p.z << ") is moved; thickness "
+                                             << thickness << ", signed distance " << signed_distance(collider, p));
+        }
+    }
+    std::uniform_real_distribution<float> extent(0.0f, 0.05f);
+    const glm::vec3 e(extent(rng), extent(rng), extent(rng));
+    const Box box{p - e, p + e};
+    if (may_touch(collider, thickness, box)) return;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::vec3 q((corner & 1) ? box.hi.x : box.lo.x, (corner & 2) ? box.hi.y : box.lo.y,
+                          (corner & 4) ? box.hi.z : box.lo.z);
+        if (collider_moves(collider, thickness, q)) {
+            FAIL_CHECK("corner (" << q.x << ", " << q.y << ", " << q.z << ") of a rejected box is moved");
+        }
+    }
+}
+
+constexpr int kTrials = 20000;
+
+}  // namespace
+
+TEST_CASE("broad_phase particle_bounds is the box of the finite coordinates of its range", "[broad_phase]") {
+    std::mt19937 rng(11);
+    Vec3Array p;
+    p.resize(21);  // past two AVX2 blocks of 8, with a tail
+    for (std::size_t i = 0; i < p.size(); ++i) p.set(i, random_vec(rng, 5.0f));
+    for (std::size_t i : {0u, 3u, 9u, 17u, 20u}) p.set(i, glm::vec3(NAN));  // in vector blocks and in the tail
+    p.x[5] = NAN;  // one coordinate NaN: that coordinate is left out
+    p.z[12] = NAN;
+    for (std::size_t begin = 0; begin <= p.size(); ++begin) {
+        for (std::size_t end = begin; end <= p.size(); ++end) {
+            INFO("range [" << begin << ", " << end << ")");
+            const Box got = particle_bounds(p, begin, end);
+            const Box want = reference_bounds(p, begin, end);
+            CHECK(got.empty() == want.empty());
+            if (want.empty()) continue;
+            CHECK(got.lo == want.lo);
+            CHECK(got.hi == want.hi);
+            CHECK(std::isfinite(got.lo.x + got.lo.y + got.lo.z + got.hi.x + got.hi.y + got.hi.z));
+        }
+    }
+    // An empty range, and a range of NaN particles only, give the empty box, which touches nothing.
+    CHECK(particle_bounds(p, 4, 4).empty());
+    CHECK(particle_bounds(p, 7, 2).empty());
+    CHECK(particle_bounds(p, 0, 1).empty());
+    CHECK(Box{}.empty());
+    const Box none = particle_bounds(p, 3, 4);
+    REQUIRE(none.empty());
+    CHECK_FALSE(may_touch(SphereCollider{true, glm::vec3(0.0f), 1e6f, 0.0f}, 1.0f, none));
+    CHECK_FALSE(may_touch(CubeCollider{true, glm::vec3(0.0f), glm::vec3(1e6f), 0.0f}, 1.0f, none));
+    CHECK_FALSE(may_touch(GroundCollider{true, 1e6f, 0.0f}, 1.0f, none));
+}
+
+TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles and row_block_bounds boxes them",
+          "[broad_phase]") {
+    // A grid: every row on its own, cut into runs of at most kBlockParticles, in row order.
+    const int rows = 3, cols = static_cast<int>(2 * kBlockParticles + 5);
+    const std::size_t n = static_cast<std::size_t>(rows) * cols;
+    const std::vector<std::size_t> starts = block_starts(n, rows, cols);
+    REQUIRE(blocks_per_row(cols) == 3);
+    REQUIRE(starts.size() == static_cast<std::size_t>(rows) * blocks_per_row(cols) + 1);
+    for (int r = 0; r < rows; ++r) {
+        for (std::size_t j = 0; j < blocks_per_row(cols); ++j) {
+            CHECK(starts[r * blocks_per_row(cols) + j] == static_cast<std::size_t>(r) * cols + j * kBlockParticles);
+        }
+    }
+    CHECK(starts.back() == n);
+    CHECK(blocks_per_row(static_cast<int>(kBlockParticles)) == 1);
+    // Not a grid (rows x cols is not the particle count): runs of the particle list.
+    const std::vector<std::size_t> list = block_starts(40, 0, 0);
+    CHECK(list == std::vector<std::size_t>{0, kBlockParticles, 2 * kBlockParticles, 40});
+    CHECK(block_starts(0, 0, 0) == std::vector<std::size_t>{0});
+
+    // The boxes of one row's blocks are those particle_bounds gives, NaN particles included.
+    std::mt19937 rng(4);
+    Vec3Array p;
+    p.resize(n);
+    for (std::size_t i = 0; i < n; ++i) p.set(i, random_vec(rng, 3.0f));
+    for (std::size_t i : {std::size_t{1}, std::size_t{cols + 20u}, n - 1}) p.set(i, glm::vec3(NAN));
+    for (std::size_t i = static_cast<std::size_t>(cols); i < static_cast<std::size_t>(cols) + kBlockParticles; ++i) {
+        p.set(i, glm::vec3(NAN));  // a whole block of NaN particles: the empty box
+    }
+    std::vector<Box> boxes(blocks_per_row(cols));
+    for (int r = 0; r < rows; ++r) {
+        const std::size_t begin = static_cast<std::size_t>(r) * cols;
+        row_block_bounds(p, begin, static_cast<std::size_t>(cols), boxes.data());
+        for (std::size_t j = 0; j < boxes.size(); ++j) {
+            INFO("row " << r << ", block " << j);
+            const std::size_t b = starts[r * blocks_per_row(cols) + j], e = starts[r * blocks_per_row(cols) + j + 1];
+            const Box want = reference_bounds(p, b, e);
+            CHECK(boxes[j].empty() == want.empty());
+            if (want.empty()) continue;
+            CHECK(boxes[j].lo == want.lo);
+            CHECK(boxes[j].hi == want.hi);
+        }
+    }
+    CHECK(particle_bounds(p, static_cast<std::size_t>(cols), static_cast<std::size_t>(cols) + kBlockParticles).empty());
+}
+
+TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the collider's centre",
+          "[broad_phase]") {
+    const SphereCollider sphere{true, {0.0f, 0.5f, 0.0f}, 0.3f, 0.3f};
+    const CubeCollider cube{true, {1.0f, 0.4f, -2.0f}, {0.5f, 0.2f, 0.8f}, 0.3f};
+    const GroundCollider ground{true, -0.25f, 0.5f};
+    const float t = 0.005f;
+    const Box far{{10.0f, 10.0f, 10.0f}, {11.0f, 12.0f, 13.0f}};
+    CHECK_FALSE(may_touch(sphere, t, far));
+    CHECK_FALSE(may_touch(cube, t, far));
+    CHECK_FALSE(may_touch(ground, t, far));
+    CHECK(may_touch(sphere, t, Box{sphere.center - 0.01f, sphere.center + 0.01f}));
+    CHECK(may_touch(sphere, t, Box{sphere.center, sphere.center}));
+    CHECK(may_touch(cube, t, Box{cube.center - 0.01f, cube.center + 0.01f}));
+    CHECK(may_touch(cube, t, Box{{-100.0f, -100.0f, -100.0f}, {100.0f, 100.0f, 100.0f}}));  // encloses it
+    CHECK(may_touch(ground, t, Box{{0.0f, -0.3f, 0.0f}, {1.0f, 2.0f, 1.0f}}));
+    // Just outside the reach (surface + thickness) by far more than the rounding margin: rejected.
+    const glm::vec3 above = sphere.center + glm::vec3(0.0f, sphere.radius + t + 0.01f, 0.0f);
+    CHECK_FALSE(may_touch(sphere, t, Box{above, above + 0.1f}));
+    CHECK_FALSE(may_touch(ground, t, Box{{0.0f, ground.height + t + 0.01f, 0.0f}, {1.0f, 5.0f, 1.0f}}));
+    const float right = cube.center.x + 0.5f * cube.size.x + t + 0.01f;
+    CHECK_FALSE(may_touch(cube, t, Box{{right, 0.0f, -2.0f}, {right + 1.0f, 1.0f, -1.0f}}));
+}
+
+TEST_CASE("broad_phase may_touch never rejects a particle the sphere would move", "[broad_phase]") {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> radius(0.01f, 2.0f), thickness(0.0f, 0.02f);
+    Tally tally;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const SphereCollider sphere{true, random_vec(rng, pick_scale(rng)), radius(rng), 0.4f};
+        const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
+        const glm::vec3 p = sphere.center + random_direction(rng) * (sphere.radius + t + offset(rng));
+        check_conservative(sphere, t, p, rng, tally);
+    }
+    INFO("rejected " << tally.rejected << " (" << tally.near_rejected << " near the surface), accepted "
+                     << tally.accepted << ", moved " << tally.moved);
+    CHECK(tally.rejected > kTrials / 8);
+    CHECK(tally.near_rejected > kTrials / 40);
+    CHECK(tally.moved > kTrials / 4);
+}
+
+TEST_CASE("broad_phase may_touch never rejects a particle the cube would move", "[broad_phase]") {
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<float> edge(0.01f, 2.0f), thickness(0.0f, 0.02f), unit(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> axis(0, 2);
+    Tally tally;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const CubeCollider cube{true, random_vec(rng, pick_scale(rng)), {edge(rng), edge(rng), edge(rng)}, 0.4f};
+        const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
+        const glm::vec3 reach = 0.5f * cube.size + t;
+        // A point near a face, or (one time in three) near an edge or a corner too.
+        glm::vec3 local(unit(rng) * reach.x, unit(rng) * reach.y, unit(rng) * reach.z);
+        const int snapped = trial % 3 == 0 ? 1 + axis(rng) : 1;
+        for (int s = 0; s < snapped; ++s) {
+            const int a = axis(rng);
+            local[a] = (unit(rng) < 0.0f ? -1.0f : 1.0f) * (reach[a] + offset(rng));
+        }
+        check_conservative(cube, t, cube.center + local, rng, tally);
+    }
+    INFO("rejected " << tally.rejected << " (" << tally.near_rejected << " near the surface), accepted "
+                     << tally.accepted << ", moved " << tally.moved);
+    CHECK(tally.rejected > kTrials / 8);
+    CHECK(tally.near_rejected > kTrials / 40);
+    CHECK(tally.moved > kTrials / 4);
+}
+
+TEST_CASE("broad_phase may_touch never rejects a particle the ground would move", "[broad_phase]") {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> thickness(0.0f, 0.02f);
+    Tally tally;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const float scale = pick_scale(rng);
+        const GroundCollider ground{true, std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng) * scale, 0.5f};
+        const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
+        glm::vec3 p = random_vec(rng, scale + 1.0f);
+        p.y = ground.height + t + offset(rng);
+        check_conservative(ground, t, p, rng, tally);
+    }
+    INFO("rejected " << tally.rejected << " (" << tally.near_rejected << " near the surface), accepted "
+                     << tally.accepted << ", moved " << tally.moved);
+    CHECK(tally.rejected > kTrials / 8);
+    CHECK(tally.near_rejected > kTrials / 40);
+    CHECK(tally.moved > kTrials / 4);
+}
+
+TEST_CASE("broad_phase collide_stage with culling moves every particle exactly as testing them all", "[broad_phase]") {
+    ColliderSettings colliders;
+    colliders.sphere = {true, {0.0f, 0.3f, 0.0f}, 0.3f, 0.4f};  // resting on the ground
+    colliders.cube = {true, {0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}, 0.3f};
+    colliders.ground = {true, 0.0f, 0.5f};
+    colliders.thickness = 0.005f;
+
+    // A particle inside the sphere near its bottom is pushed below the ground: its block's box must be
+    // brought up to date so that the ground, tested next, still sees it.
+    {
+        State st = test::free_particles({{0.0f, 0.05f, 0.0f}, {2.0f, 1.0f, 2.0f}}, 1.0f);
+        CollisionBlocks blocks;
+        blocks.start = {0, 1, 2};  // one particle per block
+        StepProfile profile;
+        collide_stage(st, colliders, true, blocks, &profile);
+        INFO("particle at (" << st.position.x[0] << ", " << st.position.y[0] << ", " << st.position.z[0] << ")");
+        CHECK(st.position.y[0] >= colliders.ground.height + colliders.thickness);
+        CHECK(profile.blocks_tested[2] == 1);  // the far particle's block is culled
+        CHECK(profile.blocks_offered[2] == 2);
+    }
+
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
+    for (std::size_t size : {std::size_t{1}, std::size_t{7}, kBlockParticles, std::size_t{64}}) {
+        INFO("blocks of " << size);
+        State culled;
+        culled.position.resize(600);
+        culled.motion.resize(600);
+        culled.mass.assign(600, 1.0f);
+        culled.inverse_mass.assign(600, 1.0f);
+        culled.pinned.assign(600, 0);
+        for (std::size_t i = 0; i < 600; ++i) {
+            culled.position.set(i, {x(rng), y(rng), z(rng)});
+            culled.motion.set(i, {m(rng), m(rng), m(rng)});
+            if (i % 97 == 0) culled.pinned[i] = 1;
+        }
+        // Sort by x so that blocks are compact and many lie out of reach of one collider or another.
+        std::vector<std::size_t> order(600);
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(),
+                  [&](std::size_t a, std::size_t b) { return culled.position.x[a] < culled.position.x[b]; });
+        State sorted = culled;
+        for (std::size_t i = 0; i < order.size(); ++i) {
+            sorted.position.set(i, culled.position.get(order[i]));
+            sorted.motion.set(i, culled.motion.get(order[i]));
+            sorted.pinned[i] = culled.pinned[order[i]];
+        }
+        State all = sorted;
+        CollisionBlocks blocks;
+        for (std::size_t b = 0; b < 600; b += size) blocks.start.push_back(b);
+        blocks.start.push_back(600);
+        StepProfile profile;
+        collide_stage(sorted, colliders, true, blocks, &profile);
+        collide_all(all, colliders);
+        CHECK(sorted.position == all.position);
+        CHECK(sorted.motion == all.motion);
+        CHECK(!(sorted.position == culled.position));  // something was pushed
+        for (std::size_t c = 0; c < 3; ++c) {
+            INFO("collider " << c << ": " << profile.blocks_tested[c] << " of " << profile.blocks_offered[c]);
+            CHECK(profile.blocks_tested[c] > 0);
+            if (size <= kBlockParticles) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);
+        }
+    }
+}

@@ -11,6 +11,7 @@
 #include "shader.hpp"
 #include "window.hpp"
 
+#include "clothsim/atomic_file.hpp"
 #include "clothsim/scene.hpp"
 
 #include <GLFW/glfw3.h>
@@ -244,25 +245,11 @@ void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
     if (pressed(GLFW_KEY_ESCAPE)) requests.quit = true;
 }
 
-// Writes to a temporary file and renames it over the target, so a crash never leaves half a file.
+// Atomic (atomic_file.hpp): a failed save leaves the old file as it was and says why.
 bool save_scene(AppState& app, const std::string& path) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << to_toml(app.scene);
-        out.close();
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            app.say("could not write '" + path + "': " + std::strerror(errno), true);
-            return false;
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        app.say("could not save '" + path + "': " + ec.message(), true);
+    std::string error;
+    if (!write_file_atomically(path, to_toml(app.scene), error)) {
+        app.say("not saved: " + error, true);
         return false;
     }
     app.say("saved " + path);

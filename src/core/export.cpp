@@ -1,16 +1,15 @@
 #include "clothsim/export.hpp"
 
+#include "clothsim/atomic_file.hpp"
+
 #include <cerrno>
 #include <cstring>
+#include <sstream>
 
 namespace clothsim {
 
 bool write_obj(const MassSpring& sim, const std::string& path, std::string& error) {
-    std::ofstream out(path);
-    if (!out) {
-        error = "cannot write OBJ file '" + path + "': " + std::strerror(errno);
-        return false;
-    }
+    std::ostringstream out;
     const Topology& t = sim.topology();
     out << "# clothsim mesh: " << t.rows << " x " << t.cols << " particles, t = " << sim.time() << " s\n";
     out.precision(9);
@@ -28,9 +27,8 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
         out << "f " << tri[0] + 1 << '/' << tri[0] + 1 << ' ' << tri[1] + 1 << '/' << tri[1] + 1 << ' '
             << tri[2] + 1 << '/' << tri[2] + 1 << '\n';
     }
-    out.close();
-    if (!out) {
-        error = "failed while writing OBJ file '" + path + "'";
+    if (!write_file_atomically(path, out.str(), error)) {
+        error = "OBJ file: " + error;
         return false;
     }
     return true;
@@ -54,9 +52,10 @@ void TrajectoryWriter::record(long long step, const MassSpring& sim) {
 }
 
 bool TrajectoryWriter::finish() {
+    errno = 0;
     out_.close();
     if (!out_) {
-        error_ = "failed while writing trajectory file '" + path_ + "'";
+        error_ = "failed while writing trajectory file '" + path_ + "'" + (errno ? std::string(": ") + std::strerror(errno) : "");
         return false;
     }
     return true;

@@ -204,6 +204,14 @@ TEST_CASE("cli: a bad --set exits 2 and names the field") {
     expect_bad_input({"--headless", "--set", "cloth.rows"}, {"--set cloth.rows", "expected key=value"});
 }
 
+TEST_CASE("cli: a write failure exits 2 and names the file and the reason") {
+    // /dev/full accepts open() and fails every write with ENOSPC: a full disk, without filling one.
+    expect_bad_input({"--headless", "--steps", "2", "--trajectory", "/dev/full"},
+                     {"trajectory file", "/dev/full"});
+    // The OBJ is written atomically; a device is refused instead of being replaced by a rename.
+    expect_bad_input({"--headless", "--steps", "2", "--obj", "/dev/null"}, {"OBJ file", "/dev/null", "not a regular file"});
+}
+
 TEST_CASE("cli: an unknown flag exits 2") {
     expect_bad_input({"--headless", "--bogus"}, {"--bogus", "--help"});
 }

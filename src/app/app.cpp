@@ -8,6 +8,7 @@
 #include "layout.hpp"
 #include "picking.hpp"
 #include "renderer.hpp"
+#include "scene_loading.hpp"
 #include "shader.hpp"
 #include "window.hpp"
 
@@ -75,6 +76,16 @@ void record_energy(AppState& app) {
     app.stats.total.push(static_cast<float>(e.total()));
 }
 
+// What a new cloth resets: the grab, the accumulator, the plots, the renderer's buffers.
+void after_rebuild(AppState& app, Renderer& renderer) {
+    app.grab.reset();
+    app.accumulator = 0.0;
+    app.stats.kinetic.clear();
+    app.stats.potential.clear();
+    app.stats.total.clear();
+    renderer.set_cloth(app.sim);
+}
+
 // Builds a new simulation from app.scene; on a bad scene keeps the old one and says why.
 bool rebuild(AppState& app, Renderer& renderer) {
     try {
@@ -83,12 +94,7 @@ bool rebuild(AppState& app, Renderer& renderer) {
         app.say(std::string("not rebuilt: ") + e.what(), true);
         return false;
     }
-    app.grab.reset();
-    app.accumulator = 0.0;
-    app.stats.kinetic.clear();
-    app.stats.potential.clear();
-    app.stats.total.clear();
-    renderer.set_cloth(app.sim);
+    after_rebuild(app, renderer);
     return true;
 }
 
@@ -259,18 +265,14 @@ bool save_scene(AppState& app, const std::string& path) {
 void apply_requests(AppState& app, Renderer& renderer, const Window& window, float scale, PanelRequests& requests) {
     const float aspect = view_aspect(app, window, scale);
     if (requests.load) {
-        try {
-            Scene scene = load_scene(*requests.load);
-            app.scene = scene;
-            app.loaded = scene;
+        // Loaded and built in one step: a rejected file keeps the user's edits and the running cloth.
+        if (auto error = open_scene(*requests.load, app.scene, app.loaded, app.sim)) {
+            app.say(*error, true);
+        } else {
             app.scene_source = *requests.load;
-            if (rebuild(app, renderer)) {
-                reset_camera(app, aspect);
-                app.say("loaded " + *requests.load);
-            }
-        } catch (const SceneError& e) {
-            // The current scene and the user's edits stay as they were.
-            app.say(e.what(), true);
+            after_rebuild(app, renderer);
+            reset_camera(app, aspect);
+            app.say("loaded " + *requests.load);
         }
     }
     if (requests.reset) {

@@ -503,6 +503,18 @@ TEST_CASE("render error: a shader that does not compile names its file and line,
     }
 }
 
+TEST_CASE("render error: a missing shader file is named, exit 2") {
+    const TempDir dir("missing_shader");
+    const fs::path shaders = dir / "shaders";
+    fs::copy(fs::path(CLOTHSIM_SOURCE_DIR) / "shaders", shaders);
+    fs::remove(shaders / "lit.frag");
+    const RunResult r = run_clothsim(dir, {"--scene", "hanging", "--frames", "1", "--size", kSize},
+                                     {"CLOTHSIM_SHADERS=" + shaders.string()});
+    CAPTURE_RUN(r);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("clothsim: error:") && Contains((shaders / "lit.frag").string()));
+}
+
 TEST_CASE("render error: a missing texture is named, exit 2") {
     const TempDir dir("no_textures");
     const fs::path textures = dir / "textures";

@@ -51,6 +51,7 @@ Window::Window(glm::ivec2 size, const std::string& title, bool vsync) {
     for (int samples : {4, 0}) {
         glfwWindowHint(GLFW_SAMPLES, samples);
         window_ = glfwCreateWindow(size.x, size.y, title.c_str(), nullptr, nullptr);
+        keep_gl_driver_loaded();  // also when creation failed: the driver was loaded to try
         if (window_) {
             samples_ = samples;
             break;
@@ -74,7 +75,6 @@ Window::Window(glm::ivec2 size, const std::string& title, bool vsync) {
                           "); run clothsim --headless instead");
     }
     set_vsync(vsync);
-    keep_gl_driver_loaded();
 }
 
 Window::~Window() {

@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <type_traits>
@@ -26,11 +29,55 @@ template <class... Ts>
 struct Overloaded : Ts... {
     using Ts::operator()...;
 };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // C++20 deduces this itself; clang before 17 needs it spelled out
+
+// Arrays, tables and floats are written here, not by toml++'s formatter: toml++ 3.3 sizes arrays and
+// tables with static_cast<size_t>(log10(|x|)) per element, undefined behaviour for inf, nan, |x| < 1 and
+// INT64_MIN (the values a bad scene file holds).
+void show_into(std::string& out, const toml::node& node) {
+    if (const auto* f = node.as_floating_point()) {
+        const double v = f->get();
+        if (std::isnan(v)) {
+            out += "nan";
+        } else if (std::isinf(v)) {
+            out += v < 0 ? "-inf" : "inf";
+        } else {
+            char buffer[32];
+            const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+            const std::string_view text(buffer, static_cast<std::size_t>(result.ptr - buffer));
+            out += text;
+            if (text.find_first_of(".e") == std::string_view::npos) out += ".0";  // a float, as TOML writes it
+        }
+    } else if (const auto* array = node.as_array()) {
+        out += "[";
+        for (std::size_t i = 0; i < array->size() && out.size() <= 60; ++i) {
+            if (i) out += ", ";
+            show_into(out, *array->get(i));
+        }
+        out += "]";
+    } else if (const auto* table = node.as_table()) {
+        out += "{";
+        bool first = true;
+        for (auto&& [key, value] : *table) {
+            if (out.size() > 60) break;
+            out += first ? " " : ", ";
+            first = false;
+            out += key.str();
+            out += " = ";
+            show_into(out, value);
+        }
+        out += " }";
+    } else {
+        std::ostringstream os;
+        node.visit([&](const auto& n) { os << n; });
+        out += os.str();
+    }
+}
 
 std::string show(const toml::node& node) {
-    std::ostringstream os;
-    node.visit([&](const auto& n) { os << n; });
-    std::string s = os.str();
+    std::string s;
+    show_into(s, node);
     if (s.size() > 60) s = s.substr(0, 57) + "...";
     return s;
 }
@@ -71,8 +118,11 @@ std::optional<std::vector<std::pair<int, int>>> pin_list_of(const toml::node& no
     for (const toml::node& item : *array) {
         const toml::array* pair = item.as_array();
         if (!pair || pair->size() != 2 || !(*pair)[0].is_integer() || !(*pair)[1].is_integer()) return std::nullopt;
-        out.emplace_back(static_cast<int>((*pair)[0].as_integer()->get()),
-                         static_cast<int>((*pair)[1].as_integer()->get()));
+        const std::int64_t r = (*pair)[0].as_integer()->get(), c = (*pair)[1].as_integer()->get();
+        // Beyond int, a cast would wrap (2^32 -> 0) and pin a particle the file never named.
+        constexpr std::int64_t lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+        if (r < lo || r > hi || c < lo || c > hi) return std::nullopt;
+        out.emplace_back(static_cast<int>(r), static_cast<int>(c));
     }
     return out;
 }
@@ -169,6 +219,30 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
             },
         },
         field.ref(scene));
+}
+
+// Well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF), as TOML requires.
+bool valid_utf8(std::string_view text) {
+    std::size_t i = 0;
+    while (i < text.size()) {
+        const auto b = static_cast<unsigned char>(text[i]);
+        std::size_t length = 0;
+        std::uint32_t code = 0, least = 0;
+        if (b < 0x80) { ++i; continue; }
+        if ((b & 0xE0) == 0xC0) { length = 2; code = b & 0x1F; least = 0x80; }
+        else if ((b & 0xF0) == 0xE0) { length = 3; code = b & 0x0F; least = 0x800; }
+        else if ((b & 0xF8) == 0xF0) { length = 4; code = b & 0x07; least = 0x10000; }
+        else return false;
+        if (i + length > text.size()) return false;
+        for (std::size_t k = 1; k < length; ++k) {
+            const auto c = static_cast<unsigned char>(text[i + k]);
+            if ((c & 0xC0) != 0x80) return false;
+            code = (code << 6) | (c & 0x3F);
+        }
+        if (code < least || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
+        i += length;
+    }
+    return true;
 }
 
 std::string where(std::string_view source, const toml::node& node) {
@@ -300,6 +374,10 @@ void apply_override(Scene& scene, std::string_view assignment) {
     }
     const std::string key(assignment.substr(0, eq));
     const std::string text(assignment.substr(eq + 1));
+    // One --set is one field: a line break would let "rows=8\ncols=9" pass as a TOML document and drop the rest.
+    if (text.find_first_of("\r\n") != std::string::npos) {
+        throw SceneError(source + ": the value spans lines; give one field per --set");
+    }
     const FieldInfo* field = find_field(key);
     if (!field) {
         throw SceneError(source + ": unknown field '" + key + "'; fields: " + [] {
@@ -313,6 +391,10 @@ void apply_override(Scene& scene, std::string_view assignment) {
     try {
         parsed = toml::parse("value = " + text);
     } catch (const toml::parse_error&) {
+    }
+    // A bare word is stored as it is and written back by to_toml(): it must be text a scene file can hold.
+    if (!parsed && !valid_utf8(text)) {
+        throw SceneError(source + ": the value is not valid UTF-8; allowed: " + describe_allowed(*field));
     }
     const toml::value<std::string> bare(text);
     const toml::node& node = parsed && parsed->contains("value") ? *parsed->get("value")

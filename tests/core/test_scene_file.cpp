@@ -679,3 +679,35 @@ TEST_CASE("scene build: build_simulation pins the particles of the scene") {
     s.pins = {clothsim::PinPreset::None, {{4, 0}}};
     CHECK_THROWS_AS(clothsim::build_simulation(s), SceneError);
 }
+
+// ---------------------------------------------------------------------------------------------------------
+// Found by fuzzing (tests/fuzz): each kept as a regression test here too
+// ---------------------------------------------------------------------------------------------------------
+
+TEST_CASE("scene file: a pin coordinate beyond int is rejected, not wrapped onto another particle") {
+    const std::string error = parse_error("pins = [[4294967296, 0]]\n[cloth]\nrows = 4\ncols = 4\n");
+    CHECK_THAT(error, Contains("pins"));
+    CHECK_THAT(parse_error("pins = [[0, -4294967295]]\n"), Contains("pins"));
+}
+
+TEST_CASE("scene --set: a value spanning lines is rejected instead of half applied") {
+    clothsim::Scene scene;
+    const clothsim::Scene before = scene;
+    CHECK_THAT(override_error(scene, "cloth.rows=8\ncloth.cols=9"), Contains("spans lines"));
+    CHECK(scene.cloth.rows == before.cloth.rows);
+    CHECK(scene.cloth.cols == before.cloth.cols);
+}
+
+TEST_CASE("scene --set: a bare value that is not UTF-8 is rejected, so every scene saves and loads back") {
+    clothsim::Scene scene;
+    CHECK_THAT(override_error(scene, "name=\xff\xfe\xc3\x28"), Contains("not valid UTF-8"));
+    CHECK(scene.name == "untitled");
+    clothsim::apply_override(scene, "name=caf\xc3\xa9");  // valid UTF-8 is kept
+    CHECK(clothsim::parse_scene(clothsim::to_toml(scene), "round trip").name == "caf\xc3\xa9");
+}
+
+TEST_CASE("scene file: an error message that quotes inf, nan or INT64_MIN in an array is well defined") {
+    CHECK_THAT(parse_error("[forces]\ngravity = [0.0, -inf, 0.0]\n"), Contains("-inf"));
+    CHECK_THAT(parse_error("[forces]\nwind = [nan, 0.0, 0.0]\n"), Contains("nan"));
+    CHECK_THAT(parse_error("[cloth]\nsize = [-9223372036854775808, 1]\n"), Contains("cloth.size"));
+}

@@ -82,20 +82,9 @@ struct Bounds {
 };
 
 Bounds sane_bounds(const MassSpring& sim) {
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
-    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-        lo = glm::min(lo, sim.position(i));
-        hi = glm::max(hi, sim.position(i));
-    }
-    const ColliderSettings& c = sim.settings().colliders;
-    if (c.sphere.enabled) {
-        lo = glm::min(lo, c.sphere.center - glm::vec3(c.sphere.radius));
-        hi = glm::max(hi, c.sphere.center + glm::vec3(c.sphere.radius));
-    }
-    if (c.cube.enabled) {
-        lo = glm::min(lo, c.cube.center - 0.5f * c.cube.size);
-        hi = glm::max(hi, c.cube.center + 0.5f * c.cube.size);
-    }
+    // The start cloth, the enabled sphere and cube, and down to the ground: what the app frames.
+    glm::vec3 lo, hi;
+    scene_bounds(sim, lo, hi);
     // The cloth's diagonal: the largest distance between two particles of an unstretched cloth.
     const float diagonal = glm::length(sim.position(sim.particle_count() - 1) - sim.position(0));
     return {lo - glm::vec3(2.0f * diagonal), hi + glm::vec3(2.0f * diagonal), Bounds{}.max_strain};

@@ -7,6 +7,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <thread>
@@ -160,21 +161,29 @@ void GridSolver::step(State& state, const SimulationSettings& settings, unsigned
         for (Scratch& s : scratch_) s.window.assign(3 * row_floats, 0.0f);
         zeros_.assign(row_floats, 0.0f);
         boundary_slot_.assign(rows_, -1);
+        no_boundary_.assign(rows_, -1);
         boundary_.assign(static_cast<std::size_t>(2 * blocks) * row_floats, 0.0f);
         for (int b = 1; b < blocks; ++b) {
             const int begin = static_cast<int>(static_cast<long long>(rows_) * b / blocks);
             boundary_slot_[begin - 2] = 2 * b;
             boundary_slot_[begin - 1] = 2 * b + 1;
         }
+        team_.reset();
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
     const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
-    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
-    if (blocks == 1) {
-        sweep(state, sweep_settings, 0, rows_, scratch_[0]);
+    // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
+    const bool automatic = settings.solver.threads == 0 && blocks > 1;
+    const bool single = blocks == 1 || (automatic && team_.next_is_single());
+    if (single) {
+        const auto start = std::chrono::steady_clock::now();
+        sweep(state, sweep_settings, 0, rows_, scratch_[0], no_boundary_);
+        if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
         state.substep = h;
         return;
     }
+    const auto start = std::chrono::steady_clock::now();
+    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
 #pragma omp parallel num_threads(blocks)
     {
         // OpenMP may give fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, nesting): every thread
@@ -191,9 +200,10 @@ void GridSolver::step(State& state, const SimulationSettings& settings, unsigned
         }
 #pragma omp barrier
         for (int b = omp_get_thread_num(); b < blocks; b += team) {
-            sweep(state, sweep_settings, block_begin(b), block_begin(b + 1), scratch_[b]);
+            sweep(state, sweep_settings, block_begin(b), block_begin(b + 1), scratch_[b], boundary_slot_);
         }
     }
+    if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     state.substep = h;
 }
 
@@ -383,9 +393,10 @@ void GridSolver::spring_row(const State& state, const SpringSettings& springs, u
     spring_row_table(kAvx2, std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
-void GridSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch) {
+void GridSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
+                       const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_};
-    const SweepInput in{grid, boundary_, boundary_slot_, sweep.settings, sweep.external, sweep.h,
+    const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
     sweep_table(kAvx2, std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }

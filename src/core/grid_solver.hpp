@@ -18,6 +18,7 @@
 #include "clothsim/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
+#include "team_choice.hpp"
 
 #include <array>
 #include <optional>
@@ -41,6 +42,8 @@ public:
     // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
     // at least 8.
     int effective_threads(int requested) const;
+    // With threads = 0: whether the last substeps ran on one thread because the team was slower.
+    bool team_set_aside() const { return team_.single(); }
     // Which kernel runs on this CPU: "avx2+fma" or "generic".
     static const char* kernel_name();
     // For tests: run the generic kernel even on an AVX2 CPU (true), or go back to the CPU's best (false).
@@ -60,7 +63,8 @@ private:
         float h;
         Box* row_boxes;
     };
-    void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch);
+    void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
+               const std::vector<int>& boundary_slot);
     // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).
     void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const;
 
@@ -72,6 +76,8 @@ private:
     std::vector<float> boundary_;              // spring rows just above block boundaries
     std::vector<float> zeros_;                 // a spring row of zeros: the rows above row 0
     std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
+    std::vector<int> no_boundary_;             // all -1: one block sweeping every row
+    TeamChoice team_;                          // solver.threads = 0: the team, or one thread when it is faster
 };
 
 }  // namespace clothsim

@@ -72,7 +72,9 @@ MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
 const char* MassSpring::fast_kernel_name() { return GridSolver::kernel_name(); }
 
 int MassSpring::solver_threads() const {
-    return plan_.path == StepPath::FastSweep ? grid_.solver->effective_threads(settings_.solver.threads) : 1;
+    if (plan_.path != StepPath::FastSweep) return 1;
+    const bool set_aside = settings_.solver.threads == 0 && grid_.solver->team_set_aside();
+    return set_aside ? 1 : grid_.solver->effective_threads(settings_.solver.threads);
 }
 
 float MassSpring::substep_length() const {

@@ -148,3 +148,39 @@ TEST_CASE("grid_solver steps every row block when OpenMP gives fewer threads tha
     CHECK(nested.solver_threads() == 4);
     CHECK(bit_identical(one, nested));
 }
+
+TEST_CASE("grid solver: automatic threads switch between the team and one thread without changing a bit") {
+    Scene s = load_scene("drape-sphere");
+    s.settings.solver.threads = 0;
+    MassSpring automatic = build_simulation(s);
+    s.settings.solver.threads = 1;
+    MassSpring one = build_simulation(s);
+    for (int i = 0; i < 600; ++i) {  // several probes of the other choice (every 64 substeps at first)
+        automatic.step();
+        one.step();
+    }
+    CHECK(automatic.positions() == one.positions());
+}
+
+TEST_CASE("team choice: uses the faster of team and one thread, probing the other less while it loses") {
+    using std::chrono::microseconds;
+    TeamChoice choice;
+    int probes = 0;
+    auto run = [&](int substeps, int team_us, int single_us) {
+        for (int i = 0; i < substeps; ++i) {
+            const bool single = choice.next_is_single();
+            if (single != choice.single()) ++probes;
+            choice.record(single, microseconds(single ? single_us : team_us));
+        }
+    };
+    run(64, 100, 170);  // a healthy team: the first probe of one thread loses
+    CHECK_FALSE(choice.single());
+    probes = 0;
+    run(64 * 2 + 64 * 4 + 64 * 8, 100, 170);  // the waits double after each lost probe
+    CHECK(probes == 3);
+    CHECK_FALSE(choice.single());
+    run(8192, 5000, 170);  // the team is starved by another process: one thread wins at the next probe
+    CHECK(choice.single());
+    run(8192, 100, 170);  // the core is free again: a probe of the team finds it faster
+    CHECK_FALSE(choice.single());
+}

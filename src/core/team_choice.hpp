@@ -1,0 +1,51 @@
+// TeamChoice: whether the fast solver's thread team is worth its barriers right now.
+//
+// OpenMP's barrier spins for a while, then sleeps. When another process holds one of the team's cores, the
+// descheduled thread reaches the barrier a scheduler slice late, every substep: a 40 x 40 drape went from
+// 0.85 ms to over 100 ms per step while a test suite ran beside it. With solver.threads = 0 the solver
+// therefore keeps a running estimate of a substep's time with the team and with one thread, times one
+// substep the other way now and then (a probe), and uses whichever is faster. A probe that loses doubles the
+// wait before the next one (64 to 4096 substeps), so a team that stays slow costs little to keep checking.
+// Results are bit-identical for any thread count (grid_solver.hpp), so switching never changes the cloth.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+
+namespace clothsim {
+
+class TeamChoice {
+public:
+    static constexpr int kFirstProbe = 64, kLongestWait = 4096;  // substeps between probes
+
+    // Whether the next substep should run on one thread.
+    bool next_is_single() {
+        probing_ = ++since_probe_ >= wait_;
+        if (probing_) since_probe_ = 0;
+        return probing_ ? !single_ : single_;
+    }
+    // Records how long a substep took with one thread (`single`) or the team, and chooses again.
+    void record(bool single, std::chrono::steady_clock::duration elapsed) {
+        const double us = std::chrono::duration<double, std::micro>(elapsed).count();
+        double& estimate = single ? single_us_ : team_us_;
+        // Exponential average of the choice in use; a probe replaces the other choice's estimate, which is
+        // as old as the last probe (the load it saw may be gone).
+        estimate = estimate < 0.0 || probing_ ? us : estimate + kWeight * (us - estimate);
+        if (single_us_ < 0.0 || team_us_ < 0.0) return;
+        const bool was = single_;
+        single_ = single_us_ < team_us_;
+        if (probing_) wait_ = single_ != was ? kFirstProbe : std::min(2 * wait_, kLongestWait);
+    }
+    bool single() const { return single_; }
+    void reset() { *this = TeamChoice{}; }
+
+private:
+    static constexpr double kWeight = 0.25;
+    bool single_ = false;
+    bool probing_ = false;
+    int since_probe_ = 0;
+    int wait_ = kFirstProbe;
+    double single_us_ = -1.0, team_us_ = -1.0;
+};
+
+}  // namespace clothsim

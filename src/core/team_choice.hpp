@@ -17,24 +17,30 @@ namespace clothsim {
 class TeamChoice {
 public:
     static constexpr int kFirstProbe = 64, kLongestWait = 4096;  // substeps between probes
+    static constexpr int kProbeLength = 3;                         // substeps a probe runs the other way
 
     // Whether the next substep should run on one thread.
     bool next_is_single() {
-        probing_ = ++since_probe_ >= wait_;
-        if (probing_) since_probe_ = 0;
-        return probing_ ? !single_ : single_;
+        if (probe_left_ == 0 && ++since_probe_ >= wait_) {
+            since_probe_ = 0;
+            probe_left_ = kProbeLength;
+        }
+        return probe_left_ > 0 ? !single_ : single_;
     }
     // Records how long a substep took with one thread (`single`) or the team, and chooses again.
     void record(bool single, std::chrono::steady_clock::duration elapsed) {
         const double us = std::chrono::duration<double, std::micro>(elapsed).count();
+        const bool probing = probe_left_ > 0;
+        // A probe's first substeps move the data into the other cores' caches: only its last one counts.
+        if (probing && --probe_left_ > 0) return;
         double& estimate = single ? single_us_ : team_us_;
         // Exponential average of the choice in use; a probe replaces the other choice's estimate, which is
         // as old as the last probe (the load it saw may be gone).
-        estimate = estimate < 0.0 || probing_ ? us : estimate + kWeight * (us - estimate);
+        estimate = estimate < 0.0 || probing ? us : estimate + kWeight * (us - estimate);
         if (single_us_ < 0.0 || team_us_ < 0.0) return;
         const bool was = single_;
         single_ = single_us_ < team_us_;
-        if (probing_) wait_ = single_ != was ? kFirstProbe : std::min(2 * wait_, kLongestWait);
+        if (probing) wait_ = single_ != was ? kFirstProbe : std::min(2 * wait_, kLongestWait);
     }
     bool single() const { return single_; }
     void reset() { *this = TeamChoice{}; }
@@ -42,7 +48,7 @@ public:
 private:
     static constexpr double kWeight = 0.25;
     bool single_ = false;
-    bool probing_ = false;
+    int probe_left_ = 0;
     int since_probe_ = 0;
     int wait_ = kFirstProbe;
     double single_us_ = -1.0, team_us_ = -1.0;

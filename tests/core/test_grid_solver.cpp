@@ -165,22 +165,26 @@ TEST_CASE("grid solver: automatic threads switch between the team and one thread
 TEST_CASE("team choice: uses the faster of team and one thread, probing the other less while it loses") {
     using std::chrono::microseconds;
     TeamChoice choice;
-    int probes = 0;
+    // Runs substeps with the given costs; returns how many ran the choice not currently preferred.
     auto run = [&](int substeps, int team_us, int single_us) {
+        int other = 0;
         for (int i = 0; i < substeps; ++i) {
             const bool single = choice.next_is_single();
-            if (single != choice.single()) ++probes;
+            other += single != choice.single();
             choice.record(single, microseconds(single ? single_us : team_us));
         }
+        return other;
     };
-    run(64, 100, 170);  // a healthy team: the first probe of one thread loses
+    // A healthy team: one thread loses every probe, and the waits double (64, 128, ... 4096 substeps), so
+    // 8000 substeps hold at most 7 probes of 3 substeps each.
+    const int probed = run(8000, 100, 170);
     CHECK_FALSE(choice.single());
-    probes = 0;
-    run(64 * 2 + 64 * 4 + 64 * 8, 100, 170);  // the waits double after each lost probe
-    CHECK(probes == 3);
-    CHECK_FALSE(choice.single());
-    run(8192, 5000, 170);  // the team is starved by another process: one thread wins at the next probe
+    CHECK(probed > 0);
+    CHECK(probed <= 7 * TeamChoice::kProbeLength);
+    // The team is starved by another process: one thread wins at the next probe.
+    run(8192, 5000, 170);
     CHECK(choice.single());
-    run(8192, 100, 170);  // the core is free again: a probe of the team finds it faster
+    // The core is free again: a probe of the team finds it faster.
+    run(8192, 100, 170);
     CHECK_FALSE(choice.single());
 }

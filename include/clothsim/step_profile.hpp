@@ -31,6 +31,11 @@ inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count
 // Lower-case names, as the panel and the JSON show them.
 std::string_view stage_name(Stage stage);
 
+// The collider a stage times, as an index of StepProfile's block counts (0 sphere, 1 cube, 2 ground), or -1.
+constexpr int collider_index(Stage stage) {
+    return stage == Stage::Sphere ? 0 : stage == Stage::Cube ? 1 : stage == Stage::Ground ? 2 : -1;
+}
+
 struct StepProfile {
     std::array<double, kStageCount> ms{};         // wall time spent in each stage
     std::array<long long, kStageCount> runs{};    // times the stage ran: once a substep (colliders twice when a

@@ -36,8 +36,7 @@ nlohmann::json profile_json(const StepProfile& p, const std::vector<StageStatus>
                                 {"ms_per_step", steps > 0 ? p.ms[i] / double(steps) : 0.0},
                                 {"substeps_run", p.runs[i]},
                                 {"note", s.note}};
-        if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
-            const std::size_t c = i - static_cast<std::size_t>(Stage::Sphere);
+        if (const int c = collider_index(s.stage); c >= 0) {
             stage["blocks_tested"] = p.blocks_tested[c];
             stage["blocks_offered"] = p.blocks_offered[c];
         }
@@ -57,8 +56,7 @@ void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages,
         const std::size_t i = static_cast<std::size_t>(s.stage);
         if (s.runs()) {
             std::printf(" %s %.4f", std::string(stage_name(s.stage)).c_str(), steps > 0 ? p.ms[i] / double(steps) : 0.0);
-            if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
-                const std::size_t c = i - static_cast<std::size_t>(Stage::Sphere);
+            if (const int c = collider_index(s.stage); c >= 0) {
                 std::printf(" (%lld of %lld blocks tested)", p.blocks_tested[c], p.blocks_offered[c]);
             }
             std::printf(";");

@@ -245,8 +245,7 @@ void profile_section(const AppState& app) {
     for (const StageStatus& s : describe(app.sim.plan(), app.sim.topology(), settings)) {
         const std::size_t i = static_cast<std::size_t>(s.stage);
         std::string note = s.note;
-        if (s.stage == Stage::Sphere || s.stage == Stage::Cube || s.stage == Stage::Ground) {
-            const std::size_t c = static_cast<std::size_t>(s.stage) - static_cast<std::size_t>(Stage::Sphere);
+        if (const int c = collider_index(s.stage); c >= 0) {
             if (s.runs() && frame.blocks_offered[c] > 0) {
                 note = std::to_string(frame.blocks_tested[c]) + " of " + std::to_string(frame.blocks_offered[c]) +
                        " blocks tested";

@@ -92,7 +92,7 @@ T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thicknes
 
 template <class Shape>
 void collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
-                    std::size_t which, StepProfile* profile) {
+                    int which, StepProfile* profile) {
     long long tested = 0;
     // First the whole cloth: a collider out of its reach costs this one test.
     const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
@@ -170,15 +170,15 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     const float thickness = colliders.thickness;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, 0, profile);
+        collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, 1, profile);
+        collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, 2, profile);
+        collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
     }
 }
 

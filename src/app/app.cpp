@@ -365,6 +365,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
 
     AppState app(scene, options.scene_source);
     app.auto_substeps = options.auto_substeps;
+    app.paused = options.start_paused;
     app.safety = options.safety;
     app.view = options.view;
     app.show_panel = options.show_panel;
@@ -381,6 +382,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
     long long frame = 0;
     bool vsync_applied = !scripted;
     auto last = Clock::now();
+    const auto started = last;
     while (!glfwWindowShouldClose(window->get())) {
         glfwPollEvents();
         ImGui_ImplOpenGL3_NewFrame();
@@ -457,6 +459,9 @@ int run_app(const Scene& scene, const AppOptions& options) {
             vsync_applied = app.vsync;
         }
         glfwSwapBuffers(window->get());
+        if (options.quit_after && std::chrono::duration<double>(Clock::now() - started).count() >= *options.quit_after) {
+            requests.quit = true;
+        }
         if (requests.quit) glfwSetWindowShouldClose(window->get(), GLFW_TRUE);
         apply_requests(app, *renderer, *window, scale, requests);
     }

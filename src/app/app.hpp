@@ -19,6 +19,10 @@ struct AppOptions {
     // clock says), write the last one to `screenshot` (panel included) and exit.
     std::optional<long long> frames;
     std::string screenshot;
+    // Interactive runs: start paused (--paused; nothing is stepped until Play, Space or S), and end after
+    // this many wall seconds as if the window were closed (--quit-after; exit code 0).
+    bool start_paused = false;
+    std::optional<double> quit_after;
     ViewSettings view;       // the View section's start values (--view)
     bool show_panel = true;
     // Auto substeps (on in interactive runs; scripted runs step exactly what the scene says unless asked).

@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     AppOptions app_options;
     std::string size_text;
 
-    app.add_flag("--headless", headless, "Simulate without a window and report on stdout");
+    auto* headless_flag = app.add_flag("--headless", headless, "Simulate without a window and report on stdout");
     app.add_option("--scene", scene_name, "Bundled scene name or path to a .toml scene file")->capture_default_str();
     auto* duration = app.add_option("--duration", options.duration, "Simulated seconds to run (default 1)")
                          ->check(CLI::PositiveNumber);
@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
                        ->check(CLI::PositiveNumber);
     app.add_option("--screenshot", app_options.screenshot, "App: with --frames, write the last frame as PNG")
         ->needs(frames);
+    app.add_flag("--paused", app_options.start_paused, "App: start paused (Space or Play runs, S steps once)")
+        ->excludes(headless_flag);
+    app.add_option("--quit-after", app_options.quit_after, "App: close the window after this many wall seconds")
+        ->check(CLI::PositiveNumber)
+        ->excludes(frames)
+        ->excludes(headless_flag);
     app.add_option("--size", size_text, "App: window size WxH in screen coordinates (default 1280x720)");
     std::vector<std::string> view_items;
     app.add_option("--view", view_items,

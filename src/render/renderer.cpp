@@ -127,43 +127,48 @@ Renderer::Renderer(const std::filesystem::path& shader_dir, const std::filesyste
     glBindVertexArray(0);
 }
 
-void Renderer::set_cloth(const MassSpring& sim) {
-    const Topology& t = sim.topology();
-    MeshData data;
-    data.positions = sim.positions();
-    compute_vertex_normals(t, sim.state().position, data.normals);
-    for (int r = 0; r < t.rows; ++r) {
-        for (int c = 0; c < t.cols; ++c) {
-            data.uvs.emplace_back(t.cols > 1 ? float(c) / float(t.cols - 1) : 0.0f,
-                                  t.rows > 1 ? 1.0f - float(r) / float(t.rows - 1) : 0.0f);
-        }
-    }
-    for (const auto& tri : t.triangles) data.indices.insert(data.indices.end(), tri.begin(), tri.end());
-    cloth_.emplace(data, true);
-    cloth_particles_ = sim.particle_count();
-    uploaded_stamp_ = sim.change_stamp();
-    // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
-    const float width = glm::length(data.positions[t.index(0, t.cols - 1)] - data.positions[0]);
-    const float height = glm::length(data.positions[t.index(t.rows - 1, 0)] - data.positions[0]);
-    cloth_uv_scale_ = glm::max(glm::vec2(width, height) / 0.12f, glm::vec2(1.0f));
-}
+void Renderer::set_cloth(const MassSpring& sim) { sync_cloth(sim, true); }
 
-void Renderer::upload_cloth(const MassSpring& sim) {
+// Brings the CPU copy and the GPU mesh to `sim`'s positions. A rebuild (or a cloth of another particle
+// count) makes the mesh anew from the copy; otherwise the copy and the mesh's vertex buffers are refreshed
+// when the cloth moved since the last sync (MassSpring::change_stamp, unique across simulations).
+void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
     using Clock = std::chrono::steady_clock;
     cloth_timings_.normals_ms = cloth_timings_.upload_ms = 0.0f;
     cloth_timings_.cloth_uploaded = false;
-    if (!cloth_ || cloth_particles_ != sim.particle_count()) {
-        set_cloth(sim);
-    } else if (sim.change_stamp() == uploaded_stamp_) {
+    rebuild = rebuild || !cloth_ || positions_.size() != sim.particle_count();
+    if (!rebuild && sim.change_stamp() == synced_stamp_) {
         ++cloth_timings_.skipped;  // nothing moved (a sleeping or paused cloth): the GPU has these positions
         return;
     }
     const auto start = Clock::now();
+    const Topology& t = sim.topology();
     positions_ = sim.positions();
-    compute_vertex_normals(sim.topology(), sim.state().position, normals_);
+    compute_vertex_normals(t, sim.state().position, normals_);
     const auto normals_done = Clock::now();
-    cloth_->update_positions_normals(positions_, normals_);
-    uploaded_stamp_ = sim.change_stamp();
+    if (rebuild) {
+        MeshData data;
+        data.positions = positions_;
+        data.normals = normals_;
+        for (int r = 0; r < t.rows; ++r) {
+            for (int c = 0; c < t.cols; ++c) {
+                data.uvs.emplace_back(t.cols > 1 ? float(c) / float(t.cols - 1) : 0.0f,
+                                      t.rows > 1 ? 1.0f - float(r) / float(t.rows - 1) : 0.0f);
+            }
+        }
+        for (const auto& tri : t.triangles) data.indices.insert(data.indices.end(), tri.begin(), tri.end());
+        cloth_.emplace(data, true);
+        // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
+        glm::vec2 extent(0.0f);
+        if (!positions_.empty()) {
+            extent = {glm::length(positions_[t.index(0, t.cols - 1)] - positions_[0]),
+                      glm::length(positions_[t.index(t.rows - 1, 0)] - positions_[0])};
+        }
+        cloth_uv_scale_ = glm::max(extent / 0.12f, glm::vec2(1.0f));
+    } else {
+        cloth_->update_positions_normals(positions_, normals_);
+    }
+    synced_stamp_ = sim.change_stamp();
     cloth_timings_.normals_ms = std::chrono::duration<float, std::milli>(normals_done - start).count();
     cloth_timings_.upload_ms = std::chrono::duration<float, std::milli>(Clock::now() - normals_done).count();
     cloth_timings_.cloth_uploaded = true;
@@ -171,7 +176,7 @@ void Renderer::upload_cloth(const MassSpring& sim) {
 }
 
 void Renderer::draw(const RenderInput& input) {
-    upload_cloth(input.sim);
+    sync_cloth(input.sim, false);
     const glm::ivec4 vp = input.viewport_px;
     const float aspect = float(vp.z) / float(std::max(vp.w, 1));
     const glm::mat4 view_projection = input.camera.projection(aspect) * input.camera.view();
@@ -280,6 +285,10 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
 void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projection) {
     const MassSpring& sim = input.sim;
     const ViewSettings& view = input.view;
+    // sync_cloth ran this frame, so the copy has one position per particle of `sim`; every index below
+    // (triangles, springs, pins, the grab) is a particle of `sim`.
+    const std::span<const glm::vec3> positions = positions_;
+    if (positions.size() != sim.particle_count()) return;
     lines_.use();
     lines_.set("u_view_projection", view_projection);
     lines_.set("u_round_points", 0);
@@ -298,15 +307,15 @@ void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projec
         const glm::vec4 wire(0.95f, 0.55f, 0.35f, 1.0f);
         for (const auto& t : sim.topology().triangles) {
             for (int e = 0; e < 3; ++e) {
-                debug_.push_back({positions_[t[e]], wire});
-                debug_.push_back({positions_[t[(e + 1) % 3]], wire});
+                debug_.push_back({positions[t[e]], wire});
+                debug_.push_back({positions[t[(e + 1) % 3]], wire});
             }
         }
         flush(GL_LINES);
     }
     if (view.springs != SpringView::Off) {
         for (const Spring& s : sim.topology().springs) {
-            const glm::vec3 a = positions_[s.a], b = positions_[s.b];
+            const glm::vec3 a = positions[s.a], b = positions[s.b];
             glm::vec4 color = kind_color(s.kind);
             if (view.springs == SpringView::ByStrain) {
                 const float strain = s.rest_length > 0.0f ? glm::length(b - a) / s.rest_length - 1.0f : 0.0f;
@@ -323,19 +332,19 @@ void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projec
     glDisable(GL_DEPTH_TEST);
     if (view.particles) {
         lines_.set("u_point_size", 4.0f);
-        for (std::size_t i = 0; i < sim.particle_count(); ++i) debug_.push_back({positions_[i], {0.1f, 0.1f, 0.1f, 1.0f}});
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) debug_.push_back({positions[i], {0.1f, 0.1f, 0.1f, 1.0f}});
         flush(GL_POINTS);
     }
     if (view.highlight_pins) {
         lines_.set("u_point_size", 9.0f);
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-            if (sim.state().pinned[i] && i != input.grabbed) debug_.push_back({positions_[i], {0.9f, 0.1f, 0.1f, 1.0f}});
+            if (sim.state().pinned[i] && i != input.grabbed) debug_.push_back({positions[i], {0.9f, 0.1f, 0.1f, 1.0f}});
         }
         flush(GL_POINTS);
     }
-    if (input.grabbed && *input.grabbed < positions_.size()) {
+    if (input.grabbed && *input.grabbed < positions.size()) {
         lines_.set("u_point_size", 12.0f);
-        debug_.push_back({positions_[*input.grabbed], {1.0f, 0.9f, 0.1f, 1.0f}});
+        debug_.push_back({positions[*input.grabbed], {1.0f, 0.9f, 0.1f, 1.0f}});
         flush(GL_POINTS);
     }
     glEnable(GL_DEPTH_TEST);

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace clothsim {
@@ -59,7 +60,8 @@ public:
     // Loads the shaders and textures; throws gl::ShaderError or std::runtime_error naming the file.
     Renderer(const std::filesystem::path& shader_dir, const std::filesystem::path& texture_dir);
 
-    // Must be called when the cloth's topology changes (a rebuild): re-creates the cloth's buffers.
+    // Must be called when the simulation is replaced or its topology changes (a rebuild, a reset, a scene
+    // opened): re-creates the cloth's mesh and its CPU copy from `sim`, at once.
     void set_cloth(const MassSpring& sim);
     void draw(const RenderInput& input);
 
@@ -75,8 +77,12 @@ public:
     };
     const ClothTimings& cloth_timings() const { return cloth_timings_; }
 
+    // The cloth's positions as the renderer holds them (what the last draw showed): always one per particle
+    // of the cloth last given to set_cloth or draw.
+    std::span<const glm::vec3> cloth_positions() const { return positions_; }
+
 private:
-    void upload_cloth(const MassSpring& sim);
+    void sync_cloth(const MassSpring& sim, bool rebuild);
     void draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection);
     void draw_lit(const RenderInput& input, const glm::mat4& view_projection, const glm::mat4& light_view_projection);
     void draw_debug(const RenderInput& input, const glm::mat4& view_projection);
@@ -93,12 +99,13 @@ private:
     GpuMesh sphere_;
     GpuMesh cube_;
     GpuMesh ground_;
+    // The cloth as drawn: the CPU copy (positions_, normals_) and the GPU mesh made from that copy. Only
+    // sync_cloth writes them, all together, so the copy, the mesh and the stamp always describe one cloth.
     std::optional<GpuMesh> cloth_;
-    std::size_t cloth_particles_ = 0;
-    std::uint64_t uploaded_stamp_ = 0;  // the change_stamp of the positions on the GPU (0: none)
+    std::vector<glm::vec3> positions_, normals_;
+    std::uint64_t synced_stamp_ = 0;  // the change_stamp of positions_ (0: none; stamps start at 1)
     ClothTimings cloth_timings_;
     glm::vec2 cloth_uv_scale_{1.0f};
-    std::vector<glm::vec3> positions_, normals_;
 
     // Debug lines and points: position + colour per vertex, rebuilt each frame they are shown.
     gl::VertexArray debug_vao_;

@@ -1,0 +1,173 @@
+// The desktop app under a user's hands: clothsim started as a user starts it, in a real window, driven with
+// keys and clicks (user_session.hpp), never with --frames. The frames a user sees before the first physics
+// step (a fast first frame, a paused app, Reset or a scene opened while paused, a click before the cloth
+// moves) are drawn from the cloth that is loaded, whatever debug view is on.
+#include "run_process.hpp"
+#include "screen.hpp"
+#include "user_session.hpp"
+
+#include "clothsim/scene.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+using Catch::Contains;
+using namespace clothsim::test;
+
+namespace {
+
+const std::string kEveryDebugView = "wireframe,springs=kind,particles";  // pins are highlighted by default
+
+// A pin's marker: drawn in (0.9, 0.1, 0.1) over everything else.
+bool is_pin_red(Rgb c) { return c.r > 180 && c.g < 90 && c.b < 90; }
+
+bool red_near(const Image& image, glm::vec3 screen, int radius) {
+    for (int dy = -radius; dy <= radius; ++dy) {
+        for (int dx = -radius; dx <= radius; ++dx) {
+            const int x = static_cast<int>(screen.x) + dx, y = static_cast<int>(screen.y) + dy;
+            if (x >= 0 && y >= 0 && x < image.width && y < image.height && is_pin_red(image.at(x, y))) return true;
+        }
+    }
+    return false;
+}
+
+// Where the app's start camera shows particle `i` of `scene`'s initial cloth.
+glm::vec3 particle_on_screen(const clothsim::Scene& scene, std::size_t i) {
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    return to_screen(start_camera(sim), sim.particle(i).position);
+}
+
+std::vector<std::size_t> pinned_particles(const clothsim::Scene& scene) {
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    std::vector<std::size_t> pins;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        if (sim.particle(i).pinned) pins.push_back(i);
+    }
+    return pins;
+}
+
+std::string at_xy(glm::vec3 p) { return std::to_string(static_cast<int>(p.x)) + " " + std::to_string(static_cast<int>(p.y)); }
+
+std::string scene_path(const std::string& name) {
+    return std::string(CLOTHSIM_SOURCE_DIR) + "/assets/scenes/" + name + ".toml";
+}
+
+}  // namespace
+
+TEST_CASE("user session: clothsim started with no flag draws, runs and quits on Escape with exit 0") {
+    const TempDir dir("session_plain");
+    const RunResult r = run_user_session(dir, {}, "settle\nsettle\nquit\n");
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+}
+
+TEST_CASE("user session: --quit-after ends an interactive run with exit 0") {
+    const TempDir dir("session_quit_after");
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--quit-after", "2"}, "");
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+}
+
+TEST_CASE("user session: launched paused with every debug view, the first frames draw the loaded cloth") {
+    for (const std::string scene_name : {"flag", "hanging"}) {
+        INFO("scene " << scene_name);
+        const TempDir dir("session_paused_" + scene_name);
+        const RunResult r = run_user_session(
+            dir, {"--scene", scene_name, "--paused", "--view", kEveryDebugView}, "shot start.png\nquit\n");
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        const Image image = load_png(dir / "start.png");
+        REQUIRE(image.width == kWidth);
+        // No step has run: every pin's marker sits where the scene puts the pin.
+        const clothsim::Scene scene = clothsim::load_scene(scene_name);
+        for (std::size_t pin : pinned_particles(scene)) {
+            INFO("pin " << pin);
+            CHECK(red_near(image, particle_on_screen(scene, pin), 3));
+        }
+    }
+}
+
+TEST_CASE("user session: Reset while paused shows the start state, debug views included") {
+    const TempDir dir("session_reset_paused");
+    // Start, play 1.5 s, pause, look, Reset, look.
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", kEveryDebugView + ",no-panel"},
+                                         "shot start.png\nkey space\nsleep 1.5\nkey space\nshot moved.png\n"
+                                         "key r\nshot reset.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const Image start = load_png(dir / "start.png"), moved = load_png(dir / "moved.png"),
+                reset = load_png(dir / "reset.png");
+    REQUIRE((start.width == kWidth && moved.width == kWidth && reset.width == kWidth));
+    const Rect whole{0, 0, kWidth, kHeight};
+    CHECK(differing_pixels(start, moved, whole, 30) > 1000);  // the flag moved while it played
+    CHECK(differing_pixels(start, reset, whole, 30) == 0);    // and R drew the start again, wires and dots too
+}
+
+TEST_CASE("user session: a scene of another size opened while paused is drawn as loaded, debug views included") {
+    const std::string view_flags = kEveryDebugView;
+    // The reference: curtain (40 x 48) launched paused.
+    const TempDir ref_dir("session_open_reference");
+    const RunResult ref = run_user_session(ref_dir, {"--scene", scene_path("curtain"), "--paused", "--view", view_flags},
+                                           "shot curtain.png\nquit\n");
+    CAPTURE_RUN(ref);
+    REQUIRE(ref.code == 0);
+    const Image expected = load_png(ref_dir / "curtain.png");
+    REQUIRE(expected.width == kWidth);
+
+    SECTION("picked in the bundled-scene combo") {
+        const TempDir dir("session_open_combo");
+        // flag (24 x 36), paused; the combo at the top of the panel, curtain its first item.
+        const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
+                                             "click 110 59\nclick 40 84\nshot opened.png\nquit\n");
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        const Image opened = load_png(dir / "opened.png");
+        REQUIRE(opened.width == kWidth);
+        CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
+    }
+    SECTION("typed into the file field and opened with the Open file button") {
+        const TempDir dir("session_open_file");
+        const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
+                                             "click 115 82\nkey ctrl+a\ntype '" + scene_path("curtain") +
+                                                 "'\nclick 270 82\nshot opened.png\nquit\n");
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        const Image opened = load_png(dir / "opened.png");
+        REQUIRE(opened.width == kWidth);
+        CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
+    }
+}
+
+TEST_CASE("user session: ctrl+click on a pin and a grab before the first step, with every debug view") {
+    const clothsim::Scene scene = clothsim::load_scene("hanging");
+    const std::vector<std::size_t> pins = pinned_particles(scene);
+    REQUIRE(!pins.empty());
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const glm::vec3 grab = particle_on_screen(scene, middle);
+    const TempDir dir("session_pin_grab");
+    const RunResult r = run_user_session(
+        dir, {"--scene", "hanging", "--paused", "--view", kEveryDebugView},
+        "ctrl_click " + at_xy(particle_on_screen(scene, pins[0])) + "\nshot unpinned.png\n" + "drag " + at_xy(grab) +
+            " " + std::to_string(static_cast<int>(grab.x) + 60) + " " + std::to_string(static_cast<int>(grab.y) - 80) +
+            "\nshot grabbed.png\nkey space\nsettle\nquit\n");
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+    const Image grabbed = load_png(dir / "grabbed.png");
+    REQUIRE(grabbed.width == kWidth);
+    // The other pins still show where they are.
+    for (std::size_t k = 1; k < pins.size(); ++k) CHECK(red_near(grabbed, particle_on_screen(scene, pins[k]), 3));
+}
+
+TEST_CASE("user session: a launch whose first step the guard rejects keeps drawing and quits with exit 0") {
+    for (const char* set : {"springs.structural=1e9", "forces.gravity=[0,-100000,0]", "cloth.size=0.001"}) {
+        INFO("--set " << set);
+        const TempDir dir("session_guard");
+        const RunResult r = run_user_session(dir, {"--scene", "flag", "--set", set, "--view", kEveryDebugView},
+                                             "settle\nsettle\nquit\n");
+        CAPTURE_RUN(r);
+        CHECK(r.code == 0);
+    }
+}

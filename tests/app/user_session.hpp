@@ -1,0 +1,92 @@
+// A user at the desktop app: the real clothsim executable in a real window on an X server of its own
+// (Xvfb, so tests running side by side never share a pointer or a keyboard focus), driven with xdotool
+// (keys, clicks, ctrl+clicks, drags) exactly as a user's hands would drive it. F12 screenshots show what the
+// user sees at any moment. Nothing goes through a scripted flag except --quit-after, which ends the run.
+#pragma once
+
+#include "run_process.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace clothsim::test {
+
+// The actions a session's script may use (bash functions, after the window has appeared; $wid is it):
+//   key KEYS...          presses keys (xdotool names: space, r, w, F12, ctrl+a, Return)
+//   type TEXT            types text into the focused field
+//   click X Y            left click at window coordinates (pixels from the top-left)
+//   ctrl_click X Y       the same with Ctrl held
+//   drag X0 Y0 X1 Y1     left button down at (X0, Y0), moved to (X1, Y1), released
+//   shot NAME            an F12 screenshot, saved as NAME (a PNG in the session's directory)
+//   settle               waits for a few frames to be drawn
+//   quit                 presses Escape (the app's quit key) with the pointer over the 3D view
+// Each action waits long enough afterwards for the app to have drawn frames with it (also in the ASan build).
+inline const char* kSessionFunctions = R"sh(
+settle() { sleep 0.8; }
+# Held for 0.15 s as a hand holds a key: ImGui 1.86's widgets see the key state once a frame, so a press and
+# release within one slow frame (xdotool's plain "key") would never reach a text field.
+key() { for k in "$@"; do xdotool keydown "$k"; sleep 0.15; xdotool keyup "$k"; sleep 0.05; done; settle; }
+type() { xdotool type --delay 40 "$1"; settle; }
+at() { xdotool mousemove --window "$wid" "$1" "$2"; sleep 0.2; }
+click() { at "$1" "$2"; xdotool click 1; settle; }
+ctrl_click() { at "$1" "$2"; xdotool keydown ctrl; sleep 0.2; xdotool click 1; sleep 0.2; xdotool keyup ctrl; settle; }
+drag() { at "$1" "$2"; xdotool mousedown 1; sleep 0.3; xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5;
+         xdotool mouseup 1; settle; }
+quit() { at 900 400; key Escape; }
+shot() {
+  rm -f clothsim-*.png
+  key F12
+  for _ in $(seq 150); do ls clothsim-*.png >/dev/null 2>&1 && break; sleep 0.1; done
+  sleep 0.3
+  mv clothsim-*.png "$1" || echo "shot $1: no screenshot was written" >&2
+}
+)sh";
+
+// Runs `clothsim args...` in `dir` on a private X server, waits for its window, runs `actions` (lines of the
+// functions above; end them with quit, or give the app --quit-after), then waits up to 60 s for the app to
+// exit. The result's code is the app's exit code; 90 when no window appeared in 60 s, 91 when no X server started,
+// 92 when the app did not exit (it is killed).
+inline RunResult run_user_session(const TempDir& dir, const std::vector<std::string>& args,
+                                  const std::string& actions) {
+    std::string command = quote(CLOTHSIM_EXE);
+    for (const std::string& a : args) command.append(" ").append(quote(a));
+    const std::filesystem::path script = dir / "session.sh";
+    std::ofstream(script) << "set -u\ncd " << quote(dir.path().string()) << "\n"
+                          << R"sh(
+# A private X server: -displayfd writes its display number once it accepts clients.
+Xvfb -displayfd 3 -screen 0 1280x720x24 -nolisten tcp -noreset 3>xvfb.display 2>xvfb.log &
+xvfb=$!
+trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null' EXIT
+for _ in $(seq 200); do [ -s xvfb.display ] && break; sleep 0.05; done
+[ -s xvfb.display ] || exit 91
+export DISPLAY=":$(head -n1 xvfb.display)"
+)sh" << kSessionFunctions << command << R"sh( >app.out 2>app.err &
+app=$!
+wid=""
+for _ in $(seq 600); do
+  wid=$(xdotool search --onlyvisible --name '^clothsim' 2>/dev/null | head -n1)
+  [ -n "$wid" ] && break
+  kill -0 $app 2>/dev/null || break
+  sleep 0.1
+done
+if [ -z "$wid" ]; then
+  if kill -0 $app 2>/dev/null; then kill -9 $app; wait $app; cat app.err >&2; exit 90; fi
+  wait $app; code=$?; cat app.err >&2; exit $code
+fi
+at 900 400
+settle
+)sh" << actions << R"sh(
+for _ in $(seq 600); do kill -0 $app 2>/dev/null || break; sleep 0.1; done
+if kill -0 $app 2>/dev/null; then kill -9 $app; wait $app; cat app.err >&2; exit 92; fi
+wait $app
+code=$?
+cat app.out
+cat app.err >&2
+exit $code
+)sh";
+    return run_process("timeout", {"300", "bash", script.string()});
+}
+
+}  // namespace clothsim::test

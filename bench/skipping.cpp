@@ -129,7 +129,11 @@ int run_skipping(const SkippingOptions& o) {
                 auto setup = [&](bool far) {
                     if (far) far_profile.add(sim.profile());  // the previous B window's profile
                     sim = start;
-                    sim.settings().colliders.sphere = {far, {6.0f, 1.0f, 6.0f}, 0.3f, 0.3f};
+                    {
+                        SimulationSettings moved = sim.settings();
+                        moved.colliders.sphere = {far, {6.0f, 1.0f, 6.0f}, 0.3f, 0.3f};
+                        sim.apply(moved);
+                    }
                     sim.reset_profile();
                 };
                 Pair p = time_pair([&] { sim.run_steps(1); }, [&] { sim.run_steps(1); }, o, setup);

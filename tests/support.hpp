@@ -37,4 +37,12 @@ inline Scene chain(int particles, float spacing, float particle_mass, float k) {
     return s;
 }
 
+// Changes `sim`'s live settings through its one call (MassSpring::apply), as the panel does.
+template <class Edit>
+void edit_settings(clothsim::MassSpring& sim, Edit edit) {
+    clothsim::SimulationSettings settings = sim.settings();
+    edit(settings);
+    sim.apply(settings);
+}
+
 }  // namespace clothsim::test

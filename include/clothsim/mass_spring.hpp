@@ -4,8 +4,10 @@
 // accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,
 // ground), limit strain and speed, and once per step see whether the cloth may sleep. Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
-// Topology is fixed at construction; SimulationSettings may be edited between steps (stiffness, damping,
-// forces, colliders, dt, substeps) and take effect at the next step.
+// Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,
+// damping, forces, colliders, dt, substeps), replans the stages and wakes the cloth at that point, and the
+// next substep runs them. How wall or simulated time becomes steps (fixed step, auto substeps, the guard)
+// is the Stepper's (stepper.hpp).
 //
 // Sleeping (as Box2D's islands sleep): when solver.sleep_speed > 0 and the air is still, the cloth is
 // checked at the end of every step: each free particle's displacement since the last check, over the time
@@ -59,14 +61,16 @@ public:
     void step();
     // `steps` whole steps of settings().integration.dt, each made of `substeps` substeps.
     void run_steps(long long steps);
-    // Advances by whole substeps covering `seconds` plus what earlier calls left over; returns the number of
-    // substeps run. The remainder (< one substep) is carried to the next call.
-    long long advance(double seconds);
 
     float substep_length() const;  // s: dt / substeps
 
-    SimulationSettings& settings() { return settings_; }
     const SimulationSettings& settings() const { return settings_; }
+    // The one way to change the live settings: takes effect at the next substep. A change replans the stages
+    // (step_plan.hpp), wakes the cloth (a moved collider, wind or a slider drives it) and moves
+    // setup_stamp(); applying the settings already in force does nothing.
+    void apply(const SimulationSettings& settings);
+    // The same for integration.substeps alone (auto substeps, the guard).
+    void set_substeps(int substeps);
     const Topology& topology() const { return topology_; }
     const State& state() const { return state_; }
 
@@ -92,7 +96,7 @@ public:
     // The fast solver's spring kernel on this CPU: "avx2+fma" or "generic" (chosen at run time).
     static const char* fast_kernel_name();
 
-    // The stages the current settings run (updated at the next step after a settings change).
+    // The stages the current settings run.
     const StepPlan& plan() const { return plan_; }
     // Time per stage since the last reset_profile(); set_profiling(false) stops timing (and its clock reads).
     const StepProfile& profile() const { return profile_; }
@@ -102,13 +106,16 @@ public:
     bool asleep() const { return asleep_; }
     // s: how long the cloth has stayed under sleep_speed (it sleeps at solver.sleep_time).
     double calm_seconds() const { return calm_seconds_; }
-    // Asleep with no settings change waiting to wake it: the next step will not move anything.
-    bool resting() const { return asleep_ && settings_ == planned_; }
+    // Asleep: the next step will not move anything (every change that could move the cloth wakes it).
+    bool resting() const { return asleep_; }
     // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
     void wake();
     // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
     // positions, even across copies (a rollback), so a renderer can skip normals and uploads.
     std::uint64_t change_stamp() const { return stamp_; }
+    // Changes whenever what the stability limit depends on may have changed (the settings, a pin), so a
+    // caller can keep a limit until then.
+    std::uint64_t setup_stamp() const { return setup_stamp_; }
 
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
@@ -150,7 +157,6 @@ private:
     State state_;
     SimulationSettings settings_;
     FastSolver grid_;            // the fast solver, when the topology is a grid
-    SimulationSettings planned_; // the settings plan_ was made for
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;
@@ -158,7 +164,6 @@ private:
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array wind_;             // N, scratch: wind summed on its own before it is added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
-    double carry_ = 0.0;         // s: time advance() has not yet stepped
     int last_iterations_ = 0;
     bool asleep_ = false;
     double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
@@ -166,6 +171,7 @@ private:
     double sleep_reference_time_ = 0.0;
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;
+    std::uint64_t setup_stamp_ = 0;
 };
 
 // The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it

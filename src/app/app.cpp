@@ -11,6 +11,7 @@
 #include "scene_loading.hpp"
 #include "shader.hpp"
 #include "window.hpp"
+#include "exit_codes.hpp"
 
 #include "clothsim/atomic_file.hpp"
 #include "clothsim/scene.hpp"
@@ -76,88 +77,76 @@ void record_energy(AppState& app) {
     app.stats.total.push(static_cast<float>(e.total()));
 }
 
-// What a new cloth resets: the grab, the accumulator, the plots, the renderer's buffers.
+// What a new cloth resets: the grab, the time owed, the plots, the renderer's buffers.
 void after_rebuild(AppState& app, Renderer& renderer) {
     app.grab.reset();
-    app.accumulator = 0.0;
+    app.stepper.restart();
     app.stats.kinetic.clear();
     app.stats.potential.clear();
     app.stats.total.clear();
     renderer.set_cloth(app.sim);
 }
 
-// Builds a new simulation from app.scene; on a bad scene keeps the old one and says why.
-bool rebuild(AppState& app, Renderer& renderer) {
+// Builds a new simulation from `scene`, which becomes the document; on a bad scene keeps the old one and
+// says why.
+bool rebuild(AppState& app, Renderer& renderer, const Scene& scene) {
     try {
-        app.sim = build_simulation(app.scene);
+        app.sim = build_simulation(scene);
     } catch (const SceneError& e) {
         app.say(std::string("not rebuilt: ") + e.what(), true);
         return false;
     }
+    app.scene = scene;
     after_rebuild(app, renderer);
     return true;
 }
 
-// Fixed-step physics: whole steps of integration.dt for the wall time that passed (scaled), at most
-// max_catchup_steps per frame so a slow frame slows the simulation instead of spiralling.
+// What the guard did this frame, told to the user; when it gave up, the app pauses at the last good state.
+void report_guard(AppState& app, const StepReport& report) {
+    if (report.guard_log.empty()) return;
+    app.say(report.guard_log, report.guard_gave_up);
+    if (report.guard_gave_up) {
+        app.paused = true;
+        app.say(report.guard_log + "paused at the last good state: lower integration.dt or soften the springs, then play",
+                true);
+    }
+}
+
+// The energy plots gain a point per frame that stepped; a cloth that rested through the frame repeats the
+// last values instead of recomputing them.
+void record_plots(AppState& app, bool rested) {
+    if (rested) {
+        app.stats.kinetic.push(app.stats.kinetic.last());
+        app.stats.potential.push(app.stats.potential.last());
+        app.stats.total.push(app.stats.total.last());
+    } else {
+        record_energy(app);
+    }
+}
+
+// This frame's physics, through the stepper: one step per frame in scripted runs, one for Step, otherwise
+// the wall time that passed (scaled) in fixed steps of integration.dt.
 void simulate(AppState& app, double wall_seconds, bool scripted) {
-    app.sim.settings() = app.scene.settings;
-    // The limit depends on the settings, masses and pins: a resting cloth has had none of them change.
-    if (!app.sim.resting()) app.limit = stability_limit(app.sim);
-    if (app.auto_substeps) {
-        const int n = auto_substeps(app.limit, app.scene.settings.integration.dt, app.safety);
-        app.scene.settings.integration.substeps = n;
-        app.sim.settings().integration.substeps = n;
-    }
-    const double dt = app.scene.settings.integration.dt;
-    long long steps = 0;
-    if (scripted) {
-        steps = app.paused ? 0 : 1;
-    } else if (app.step_once) {
-        steps = 1;
-    } else if (!app.paused) {
-        app.accumulator += wall_seconds * app.time_scale;
-        steps = static_cast<long long>(app.accumulator / dt);
-        if (steps > app.max_catchup_steps) {
-            app.stats.dropped_seconds += (steps - app.max_catchup_steps) * dt;
-            steps = app.max_catchup_steps;
-            app.accumulator = 0.0;
-        } else {
-            app.accumulator -= steps * dt;
-        }
-    }
-    app.step_once = false;
     const auto start = Clock::now();
     app.sim.reset_profile();
     const bool was_resting = app.sim.resting();
-    if (steps > 0 && (was_resting || app.sim.all_finite())) {
-        // The guard: a step that blows up is rolled back and retried with twice the substeps; the user is told.
-        std::string log;
-        const bool ok = run_guarded(app.sim, steps, GuardSettings{}, log);
-        if (!log.empty()) {
-            app.scene.settings.integration.substeps = app.sim.settings().integration.substeps;
-            if (app.auto_substeps) {
-                app.auto_substeps = false;
-                log += "auto substeps turned off to keep the guard's choice\n";
-            }
-            app.say(log, !ok);
-        }
-        if (!ok) {
-            app.paused = true;
-            app.say(log + "paused at the last good state: lower integration.dt or soften the springs, then play", true);
-        }
-        if (was_resting && app.sim.resting()) {
-            // Nothing moved: the plots go on with the same values instead of recomputing them.
-            app.stats.kinetic.push(app.stats.kinetic.last());
-            app.stats.potential.push(app.stats.potential.last());
-            app.stats.total.push(app.stats.total.last());
-        } else {
-            record_energy(app);
-        }
+    StepReport report;
+    if (scripted) {
+        report = app.stepper.run(app.sim, app.paused ? 0 : 1);
+    } else if (app.step_once) {
+        report = app.stepper.run(app.sim, 1);
+    } else if (!app.paused) {
+        report = app.stepper.advance(app.sim, wall_seconds * app.time_scale);
+    } else {
+        report = app.stepper.run(app.sim, 0);  // auto substeps still follows the panel's edits
     }
+    app.step_once = false;
+    report_guard(app, report);
+    if (report.steps > 0) record_plots(app, was_resting && app.sim.resting());
+    app.stats.dropped_seconds += report.dropped_seconds;
     app.stats.profile = app.sim.profile();
     app.stats.sim_ms = std::chrono::duration<float, std::milli>(Clock::now() - start).count();
-    app.stats.substeps_last_frame = steps * app.scene.settings.integration.substeps;
+    app.stats.substeps_last_frame = report.steps * app.sim.settings().integration.substeps;
 }
 
 Ray cursor_ray(const AppState& app, const Window& window, float scale) {
@@ -254,7 +243,7 @@ void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
 // Atomic (atomic_file.hpp): a failed save leaves the old file as it was and says why.
 bool save_scene(AppState& app, const std::string& path) {
     std::string error;
-    if (!write_file_atomically(path, to_toml(app.scene), error)) {
+    if (!write_file_atomically(path, to_toml(app.document()), error)) {
         app.say("not saved: " + error, true);
         return false;
     }
@@ -275,11 +264,8 @@ void apply_requests(AppState& app, Renderer& renderer, const Window& window, flo
             app.say("loaded " + *requests.load);
         }
     }
-    if (requests.reset) {
-        app.scene = app.loaded;
-        if (rebuild(app, renderer)) app.say("reset to the start of " + app.scene.name);
-    }
-    if (requests.rebuild) rebuild(app, renderer);
+    if (requests.reset && rebuild(app, renderer, app.loaded)) app.say("reset to the start of " + app.scene.name);
+    if (requests.rebuild) rebuild(app, renderer, app.document());
     if (requests.save) save_scene(app, *requests.save);
     if (requests.frame_camera) frame_camera(app, aspect);
     if (requests.reset_camera) reset_camera(app, aspect);
@@ -321,52 +307,36 @@ std::string write_screenshot(const std::string& path, int width, int height) {
     return "";
 }
 
-int run_app(const Scene& scene, const AppOptions& options) {
-    const bool scripted = options.frames.has_value();
-    std::optional<Window> window;
-    try {
-        window.emplace(options.size, "clothsim - " + scene.name, !scripted);
-    } catch (const WindowError& e) {
-        std::cerr << "clothsim: error: " << e.what() << "\n";
-        return 2;
-    }
-    if (scripted && !options.screenshot.empty()) {
-        const auto parent = std::filesystem::path(options.screenshot).parent_path();
-        if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-            std::cerr << "clothsim: error: --screenshot " << options.screenshot << ": the directory does not exist\n";
-            return 2;
-        }
-    }
+namespace {
 
-    std::optional<Renderer> renderer;
-    try {
-        renderer.emplace(gl::shader_directory(), texture_directory());
-    } catch (const std::exception& e) {
-        std::cerr << "clothsim: error: " << e.what() << "\n";
-        return 2;
-    }
-
+// Dear ImGui over GLFW and OpenGL 3.3, scaled for the monitor; no ini file (the layout is fixed).
+void start_imgui(const Window& window, KeyQueue& keys, float scale) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
-    io.IniFilename = nullptr;  // the layout is fixed; nothing to litter the working directory with
-    const float scale = window->content_scale();
+    io.IniFilename = nullptr;
     ImFontConfig font;
     font.SizePixels = 13.0f * scale;
     io.Fonts->AddFontDefault(&font);
     ImGui::StyleColorsDark();
     ImGui::GetStyle().ScaleAllSizes(scale);
     // Installed before ImGui's, which chains to it.
-    KeyQueue keys;
-    glfwSetWindowUserPointer(window->get(), &keys);
-    glfwSetKeyCallback(window->get(), on_key);
-    ImGui_ImplGlfw_InitForOpenGL(window->get(), true);
+    glfwSetWindowUserPointer(window.get(), &keys);
+    glfwSetKeyCallback(window.get(), on_key);
+    ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
+}
 
-    AppState app(scene, options.scene_source);
-    app.auto_substeps = options.auto_substeps;
+void stop_imgui() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+}
+
+// The panel's start values: the view options, and the file fields filled with the scene's path and an
+// "-edited" name to save to.
+void start_panel(AppState& app, const Scene& scene, const AppOptions& options) {
     app.paused = options.start_paused;
-    app.safety = options.safety;
     app.view = options.view;
     app.show_panel = options.show_panel;
     app.save_path = scene.name + "-edited.toml";
@@ -374,16 +344,76 @@ int run_app(const Scene& scene, const AppOptions& options) {
                                                   ? std::filesystem::path(options.scene_source)
                                                   : scene_directory() / (options.scene_source + ".toml"))
                         .string();
-    renderer->set_cloth(app.sim);
-    reset_camera(app, view_aspect(app, *window, scale));
-    record_energy(app);
+}
 
-    int exit_code = 0;
+// The 3D view's viewport in framebuffer pixels (x, y from the bottom-left, width, height).
+glm::ivec4 view_viewport(const AppState& app, const Window& window, float scale, glm::ivec2 framebuffer) {
+    const glm::vec4 rect = view_rect(app, window, scale);
+    const float to_pixels = float(framebuffer.x) / float(std::max(window.window_size().x, 1));
+    return {glm::round(rect.x * to_pixels), 0, glm::round(rect.z * to_pixels), framebuffer.y};
+}
+
+// Draws the scene and the panel; returns what the panel asked for.
+PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window, float scale) {
+    const auto render_start = Clock::now();
+    const glm::ivec2 fb = window.framebuffer_size();
+    std::optional<std::size_t> grabbed;
+    if (app.grab) grabbed = app.grab->particle;
+    renderer.draw({app.sim, app.camera, fb, view_viewport(app, window, scale, fb), app.view, grabbed});
+    const Renderer::ClothTimings& cloth = renderer.cloth_timings();
+    app.stats.cloth_uploaded = cloth.cloth_uploaded;
+    app.stats.times.add_frame(app.stats.profile, cloth.normals_ms, cloth.upload_ms);
+    PanelRequests requests;
+    if (app.show_panel) requests = draw_panel(app, scale);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    app.stats.render_ms = std::chrono::duration<float, std::milli>(Clock::now() - render_start).count();
+    return requests;
+}
+
+// The panel's requests join the keys' (a key and a button may ask for the same thing).
+void merge_requests(PanelRequests& into, const PanelRequests& panel) {
+    into.rebuild |= panel.rebuild;
+    into.reset |= panel.reset;
+    into.frame_camera |= panel.frame_camera;
+    into.reset_camera |= panel.reset_camera;
+    into.screenshot |= panel.screenshot;
+    into.quit |= panel.quit;
+    if (panel.load) into.load = panel.load;
+    if (panel.save) into.save = panel.save;
+}
+
+// A scripted run's last frame: the screenshot it asked for. Returns the exit code.
+int finish_scripted(const AppOptions& options, glm::ivec2 fb, long long frame) {
+    if (options.screenshot.empty()) return kExitOk;
+    const std::string error = write_screenshot(options.screenshot, fb.x, fb.y);
+    if (!error.empty()) {
+        std::cerr << "clothsim: error: " << error << "\n";
+        return kExitBadInput;
+    }
+    std::cout << "wrote " << options.screenshot << " (" << fb.x << "x" << fb.y << ", frame " << frame << ")\n";
+    return kExitOk;
+}
+
+// F12: a timestamped PNG in the working directory, and where it went.
+void take_screenshot(AppState& app, glm::ivec2 fb) {
+    const std::string path = timestamped_screenshot_name();
+    const std::string error = write_screenshot(path, fb.x, fb.y);
+    app.say(error.empty() ? "screenshot saved to " + std::filesystem::absolute(path).string() : error, !error.empty());
+}
+
+// The window, the renderer and ImGui around one AppState, and the frame loop: input, physics, drawing, then
+// what the frame asked for. Returns the exit code.
+int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOptions& options, float scale) {
+    const bool scripted = options.frames.has_value();
+    KeyQueue keys;
+    start_imgui(window, keys, scale);
+    int exit_code = kExitOk;
     long long frame = 0;
     bool vsync_applied = !scripted;
     auto last = Clock::now();
     const auto started = last;
-    while (!glfwWindowShouldClose(window->get())) {
+    while (!glfwWindowShouldClose(window.get())) {
         glfwPollEvents();
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
@@ -391,84 +421,83 @@ int run_app(const Scene& scene, const AppOptions& options) {
 
         PanelRequests requests;
         handle_keys(app, keys, requests);
-        handle_mouse(app, *window, scale);
-
+        handle_mouse(app, window, scale);
         const auto now = Clock::now();
         simulate(app, std::chrono::duration<double>(now - last).count(), scripted);
         last = now;
-
-        const auto render_start = Clock::now();
-        const glm::ivec2 fb = window->framebuffer_size();
-        std::optional<std::size_t> grabbed;
-        if (app.grab) grabbed = app.grab->particle;
-        const glm::vec4 rect = view_rect(app, *window, scale);
-        const float to_pixels = float(fb.x) / float(std::max(window->window_size().x, 1));
-        const glm::ivec4 viewport(glm::round(rect.x * to_pixels), 0, glm::round(rect.z * to_pixels), fb.y);
-        renderer->draw({app.sim, app.camera, fb, viewport, app.view, grabbed});
-        const Renderer::ClothTimings& cloth = renderer->cloth_timings();
-        app.stats.cloth_uploaded = cloth.cloth_uploaded;
-        app.stats.times.add_frame(app.stats.profile, cloth.normals_ms, cloth.upload_ms);
-        if (app.show_panel) {
-            PanelRequests panel = draw_panel(app, scale);
-            requests.rebuild |= panel.rebuild;
-            requests.reset |= panel.reset;
-            requests.frame_camera |= panel.frame_camera;
-            requests.reset_camera |= panel.reset_camera;
-            requests.screenshot |= panel.screenshot;
-            requests.quit |= panel.quit;
-            if (panel.load) requests.load = panel.load;
-            if (panel.save) requests.save = panel.save;
-        }
-        ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        app.stats.render_ms = std::chrono::duration<float, std::milli>(Clock::now() - render_start).count();
-
+        merge_requests(requests, draw_frame(app, renderer, window, scale));
         ++frame;
+
         // A GL error is a bug in the renderer: scripted runs (the tests) fail on it; interactive ones say so.
         if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
             char text[96];
             std::snprintf(text, sizeof text, "OpenGL error 0x%04X in frame %lld", error, frame);
             if (scripted) {
                 std::cerr << "clothsim: error: " << text << "\n";
-                exit_code = 4;
+                exit_code = kExitGlError;
                 break;
             }
             app.say(text, true);
         }
+        const glm::ivec2 fb = window.framebuffer_size();
         if (scripted && frame >= *options.frames) {
-            if (!options.screenshot.empty()) {
-                const std::string error = write_screenshot(options.screenshot, fb.x, fb.y);
-                if (!error.empty()) {
-                    std::cerr << "clothsim: error: " << error << "\n";
-                    exit_code = 2;
-                } else {
-                    std::cout << "wrote " << options.screenshot << " (" << fb.x << "x" << fb.y << ", frame " << frame
-                              << ")\n";
-                }
-            }
+            exit_code = finish_scripted(options, fb, frame);
             break;
         }
-        if (requests.screenshot) {
-            const std::string path = timestamped_screenshot_name();
-            const std::string error = write_screenshot(path, fb.x, fb.y);
-            app.say(error.empty() ? "screenshot saved to " + std::filesystem::absolute(path).string() : error,
-                    !error.empty());
-        }
+        if (requests.screenshot) take_screenshot(app, fb);
         if (!scripted && app.vsync != vsync_applied) {
-            window->set_vsync(app.vsync);
+            window.set_vsync(app.vsync);
             vsync_applied = app.vsync;
         }
-        glfwSwapBuffers(window->get());
+        glfwSwapBuffers(window.get());
         if (options.quit_after && std::chrono::duration<double>(Clock::now() - started).count() >= *options.quit_after) {
             requests.quit = true;
         }
-        if (requests.quit) glfwSetWindowShouldClose(window->get(), GLFW_TRUE);
-        apply_requests(app, *renderer, *window, scale, requests);
+        if (requests.quit) glfwSetWindowShouldClose(window.get(), GLFW_TRUE);
+        apply_requests(app, renderer, window, scale, requests);
+    }
+    stop_imgui();
+    return exit_code;
+}
+
+}  // namespace
+
+int run_app(const Scene& scene, const AppOptions& options) {
+    const bool scripted = options.frames.has_value();
+    std::optional<Window> window;
+    try {
+        window.emplace(options.size, "clothsim - " + scene.name, !scripted);
+    } catch (const WindowError& e) {
+        std::cerr << "clothsim: error: " << e.what() << "\n";
+        return kExitBadInput;
+    }
+    if (scripted && !options.screenshot.empty()) {
+        const auto parent = std::filesystem::path(options.screenshot).parent_path();
+        if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+            std::cerr << "clothsim: error: --screenshot " << options.screenshot << ": the directory does not exist\n";
+            return kExitBadInput;
+        }
+    }
+    std::optional<Renderer> renderer;
+    try {
+        renderer.emplace(gl::shader_directory(), texture_directory());
+    } catch (const std::exception& e) {
+        std::cerr << "clothsim: error: " << e.what() << "\n";
+        return kExitBadInput;
     }
 
-    ImGui_ImplOpenGL3_Shutdown();
-    ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
+    // The app steps with the guard on: a blow-up is rolled back, retried, and told, never drawn.
+    RunPolicy policy;
+    policy.auto_substeps = options.auto_substeps;
+    policy.safety = options.safety;
+    policy.guard = true;
+    AppState app(scene, options.scene_source, policy);
+    start_panel(app, scene, options);
+    renderer->set_cloth(app.sim);
+    const float scale = window->content_scale();
+    reset_camera(app, view_aspect(app, *window, scale));
+    record_energy(app);
+    const int exit_code = main_loop(*window, *renderer, app, options, scale);
     renderer.reset();
     return exit_code;
 }

@@ -4,10 +4,12 @@
 
 #include "camera.hpp"
 #include "renderer.hpp"
+#include "scene_loading.hpp"
 
 #include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
+#include "clothsim/stepper.hpp"
 
 #include <array>
 #include <cstddef>
@@ -69,22 +71,20 @@ struct Grab {
 };
 
 struct AppState {
-    Scene scene;              // what the panel edits
+    // The document: name, cloth and pins as edited, what Reset returns to (`loaded`). The live settings are
+    // the simulation's alone; document() joins the two into what "Save scene as" writes.
+    Scene scene;
     Scene loaded;             // the scene as loaded (after --set): "reset to scene value" and R go back here
     std::string scene_source; // bundled name or path it came from
-    MassSpring sim;
+    MassSpring sim;           // the running cloth; owns the live settings (MassSpring::apply)
+    Stepper stepper;          // the run policy: fixed step, catch-up cap, auto substeps, the guard
     OrbitCamera camera;
     ViewSettings view;
     bool paused = false;
     bool step_once = false;
     float time_scale = 1.0f;   // simulated seconds per wall second
-    int max_catchup_steps = 4; // steps per frame at most; beyond that the simulation slows, never spirals
-    double accumulator = 0.0;  // s of simulated time owed to the fixed-step loop
     bool show_panel = true;
     bool vsync = true;
-    bool auto_substeps = true;  // pick integration.substeps from the critical substep every frame
-    float safety = 0.5f;        // ... so the substep is this fraction of it
-    StabilityLimit limit;       // of the current cloth and settings, updated every frame
     Stats stats;
     std::optional<Grab> grab;
     std::string status;        // the last message for the user (errors, screenshot path)
@@ -92,8 +92,11 @@ struct AppState {
     std::string open_path;     // the panel's "Open scene file" text
     std::string save_path;     // the panel's "Save scene as" text
 
-    explicit AppState(const Scene& s, std::string source)
-        : scene(s), loaded(s), scene_source(std::move(source)), sim(build_simulation(s)) {}
+    AppState(const Scene& s, std::string source, const RunPolicy& policy)
+        : scene(s), loaded(s), scene_source(std::move(source)), sim(build_simulation(s)), stepper(policy) {}
+
+    // The scene as it runs: the document with the simulation's live settings (what Save writes).
+    Scene document() const { return running_scene(scene, sim); }
 
     void say(std::string message, bool error = false) {
         status = std::move(message);

@@ -4,6 +4,7 @@
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 #include "clothsim/step_plan.hpp"
+#include "clothsim/stepper.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -72,62 +73,58 @@ void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages,
     }
 }
 
-}  // namespace
 
-int run_headless(const Scene& scene, const HeadlessOptions& options) {
-    MassSpring sim = build_simulation(scene);
-    const double dt = scene.settings.integration.dt;
-    const StabilityLimit limit = stability_limit(sim);
-    if (options.auto_substeps > 0.0f) {
-        const int chosen = auto_substeps(limit, scene.settings.integration.dt, options.auto_substeps);
-        std::fprintf(stderr, "auto substeps: critical substep %.4g s (Gershgorin), %d substeps per step keep the "
-                             "substep at %.2f of it\n",
-                     limit.critical_substep, chosen, dt / chosen / limit.critical_substep);
-        sim.settings().integration.substeps = chosen;
-    }
-    const long long steps = options.steps ? *options.steps
-                            : options.duration ? std::llround(*options.duration / dt)
-                                               : std::llround(1.0 / dt);
-
-    // Check outputs before simulating, so a long run never fails at its end.
-    std::unique_ptr<TrajectoryWriter> trajectory;
+// Checks the output paths before simulating, so a long run never fails at its end; opens the trajectory.
+// Returns an error message, or "".
+std::string open_outputs(const HeadlessOptions& options, const MassSpring& sim,
+                         std::unique_ptr<TrajectoryWriter>& trajectory) {
     if (!options.trajectory.empty()) {
         trajectory = std::make_unique<TrajectoryWriter>(options.trajectory);
-        if (!trajectory->ok()) {
-            std::cerr << "clothsim: error: " << trajectory->error() << "\n";
-            return kExitBadInput;
-        }
+        if (!trajectory->ok()) return trajectory->error();
         trajectory->record(0, sim);
     }
     if (!options.obj.empty() && !parent_exists(options.obj)) {
-        std::cerr << "clothsim: error: --obj " << options.obj << ": the directory does not exist\n";
-        return kExitBadInput;
+        return "--obj " + options.obj + ": the directory does not exist";
     }
     if (!options.obj.empty() && std::filesystem::is_directory(options.obj)) {
-        std::cerr << "clothsim: error: --obj " << options.obj << ": is a directory, not a file name\n";
-        return kExitBadInput;
+        return "--obj " + options.obj + ": is a directory, not a file name";
     }
+    return "";
+}
 
-    const auto start = std::chrono::steady_clock::now();
-    long long done = 0;
-    bool finite = sim.all_finite();
-    std::string guard_log;
+// What a run did, for the report.
+struct RunOutcome {
+    long long steps = 0;
+    bool finite = true;
     bool guard_ok = true;
-    while (finite && guard_ok && done < steps) {
-        if (options.guard) {
-            std::string log;
-            guard_ok = run_guarded(sim, 1, GuardSettings{}, log);
-            if (!log.empty()) std::cerr << log;
-            guard_log += log;
-        } else {
-            sim.run_steps(1);
-        }
-        ++done;
-        finite = sim.all_finite();
-        if (trajectory && (done % options.every == 0 || done == steps || !finite)) trajectory->record(done, sim);
-    }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::string guard_log;
+    double wall_seconds = 0.0;
+};
 
+// The run itself: one step at a time through the stepper (so the trajectory can record any step), until
+// `steps`, a non-finite cloth, or a guard that gave up.
+RunOutcome simulate(MassSpring& sim, Stepper& stepper, long long steps, const HeadlessOptions& options,
+                    TrajectoryWriter* trajectory) {
+    RunOutcome run;
+    const auto start = std::chrono::steady_clock::now();
+    run.finite = sim.all_finite();
+    while (run.finite && run.guard_ok && run.steps < steps) {
+        const StepReport report = stepper.run(sim, 1);
+        if (!report.guard_log.empty()) std::cerr << report.guard_log;
+        run.guard_log += report.guard_log;
+        run.guard_ok = !report.guard_gave_up;
+        ++run.steps;
+        run.finite = sim.all_finite();
+        if (trajectory && (run.steps % options.every == 0 || run.steps == steps || !run.finite)) {
+            trajectory->record(run.steps, sim);
+        }
+    }
+    run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return run;
+}
+
+// Closes the outputs (trajectory, OBJ) and says what failed; returns the exit code.
+int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutcome& run, TrajectoryWriter* trajectory) {
     int code = kExitOk;
     if (trajectory && !trajectory->finish()) {
         std::cerr << "clothsim: error: " << trajectory->error() << "\n";
@@ -140,49 +137,83 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
             code = kExitBadInput;
         }
     }
-    if (!finite || !guard_ok) {
-        std::cerr << "clothsim: error: the simulation " << (finite ? "kept blowing up" : "became non-finite")
-                  << " at t = " << sim.time() << " s (step " << done
+    if (!run.finite || !run.guard_ok) {
+        std::cerr << "clothsim: error: the simulation " << (run.finite ? "kept blowing up" : "became non-finite")
+                  << " at t = " << sim.time() << " s (step " << run.steps
                   << "); try a smaller integration.dt, more integration.substeps, softer springs, or --guard / "
                      "--auto-substeps\n";
         code = kExitNonFinite;
     }
+    return code;
+}
 
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+// One JSON object: the scene, what ran (the substeps in force at the end: auto substeps' choice or the
+// guard's), energies and the step profile.
+void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit) {
     const Energy e = sim.energy();
-    const StepProfile& profile = sim.profile();
     const std::vector<StageStatus> stages = describe(sim.plan(), sim.topology(), sim.settings());
-    const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
-    if (options.json) {
-        nlohmann::json out = {
-            {"scene", scene.name},
-            {"particles", sim.particle_count()},
-            {"springs", sim.spring_count()},
-            {"steps", done},
-            {"substeps_per_step", scene.settings.integration.substeps},
-            {"dt", dt},
-            {"simulated_seconds", sim.time()},
-            {"wall_seconds", wall},
-            {"finite", finite},
-            {"critical_substep", std::isfinite(limit.critical_substep) ? nlohmann::json(limit.critical_substep)
-                                                                        : nlohmann::json()},
-            {"substep", sim.substep_length()},
-            {"substeps_used", sim.settings().integration.substeps},
-            {"guard_log", guard_log},
-            {"kinetic_energy", finite_or_null(e.kinetic)},
-            {"potential_energy", finite_or_null(e.potential())},
-            {"total_energy", finite_or_null(e.total())},
-            {"profile", profile_json(profile, stages, done, sim.asleep())},
-        };
-        std::cout << out.dump(2) << std::endl;
-    } else {
-        std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(),
-                    sim.spring_count());
-        std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", done, dt,
-                    sim.settings().integration.substeps, sim.time(), wall);
-        std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
-                    e.total(), finite ? "yes" : "no");
-        print_profile(profile, stages, done, sim.asleep());
+    const nlohmann::json out = {
+        {"scene", scene.name},
+        {"particles", sim.particle_count()},
+        {"springs", sim.spring_count()},
+        {"steps", run.steps},
+        {"substeps_per_step", sim.settings().integration.substeps},
+        {"dt", sim.settings().integration.dt},
+        {"simulated_seconds", sim.time()},
+        {"wall_seconds", run.wall_seconds},
+        {"finite", run.finite},
+        {"critical_substep", finite_or_null(limit.critical_substep)},
+        {"substep", sim.substep_length()},
+        {"guard_log", run.guard_log},
+        {"kinetic_energy", finite_or_null(e.kinetic)},
+        {"potential_energy", finite_or_null(e.potential())},
+        {"total_energy", finite_or_null(e.total())},
+        {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
+    };
+    std::cout << out.dump(2) << std::endl;
+}
+
+void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run) {
+    const Energy e = sim.energy();
+    std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(), sim.spring_count());
+    std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", run.steps,
+                sim.settings().integration.dt, sim.settings().integration.substeps, sim.time(), run.wall_seconds);
+    std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
+                e.total(), run.finite ? "yes" : "no");
+    print_profile(sim.profile(), describe(sim.plan(), sim.topology(), sim.settings()), run.steps, sim.asleep());
+}
+
+}  // namespace
+
+int run_headless(const Scene& scene, const HeadlessOptions& options) {
+    MassSpring sim = build_simulation(scene);
+    RunPolicy policy;
+    policy.auto_substeps = options.auto_substeps > 0.0f;
+    policy.safety = options.auto_substeps;
+    policy.guard = options.guard;
+    Stepper stepper(policy);
+    const StabilityLimit limit = stepper.limit(sim);
+    const double dt = scene.settings.integration.dt;
+    if (policy.auto_substeps) {
+        const int chosen = stepper.choose_substeps(sim);
+        std::fprintf(stderr, "auto substeps: critical substep %.4g s (Gershgorin), %d substeps per step keep the "
+                             "substep at %.2f of it\n",
+                     limit.critical_substep, chosen, dt / chosen / limit.critical_substep);
     }
+    const long long steps = options.steps ? *options.steps
+                            : options.duration ? std::llround(*options.duration / dt)
+                                               : std::llround(1.0 / dt);
+    std::unique_ptr<TrajectoryWriter> trajectory;
+    if (const std::string error = open_outputs(options, sim, trajectory); !error.empty()) {
+        std::cerr << "clothsim: error: " << error << "\n";
+        return kExitBadInput;
+    }
+    const RunOutcome run = simulate(sim, stepper, steps, options, trajectory.get());
+    const int code = finish(options, sim, run, trajectory.get());
+    if (options.json) print_json(scene, sim, run, limit);
+    else print_text(scene, sim, run);
     return code;
 }
 

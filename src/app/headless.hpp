@@ -1,6 +1,8 @@
 // Headless runs: simulate a scene without a window and report on stdout (text or one JSON object).
 #pragma once
 
+#include "exit_codes.hpp"
+
 #include "clothsim/settings.hpp"
 
 #include <optional>
@@ -18,11 +20,6 @@ struct HeadlessOptions {
     float auto_substeps = 0.0f;      // > 0: pick integration.substeps so the substep is this fraction of dt_crit
     bool guard = false;              // roll back and double the substeps when a step blows up
 };
-
-// Exit codes of the clothsim executable.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitBadInput = 2;
-inline constexpr int kExitNonFinite = 3;
 
 int run_headless(const Scene& scene, const HeadlessOptions& options);
 

@@ -90,27 +90,49 @@ std::string label_of(const FieldInfo& f) {
     return std::string(dot == std::string_view::npos ? f.name : f.name.substr(dot + 1));
 }
 
-// Draws one field's widget; returns true when the user changed it.
-bool field_widget(AppState& app, const FieldInfo& f) {
-    ImGui::PushID(f.name.data(), f.name.data() + f.name.size());
+// A float field: a slider over the hinted extent (logarithmic where the range spans decades), else a drag.
+bool float_widget(const std::string& label, const FieldInfo& f, float* v) {
+    if (const SliderHint* h = hint_for(f.name)) {
+        const bool edited = ImGui::SliderFloat(label.c_str(), v, h->lo, h->hi, "%.4g",
+                                               h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
+        *v = std::clamp(*v, static_cast<float>(f.min), static_cast<float>(f.max));
+        return edited;
+    }
+    const float speed = std::max(std::fabs(*v) * 0.01f, 0.001f);
+    return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max), "%.4g",
+                            ImGuiSliderFlags_AlwaysClamp);
+}
+
+// The pins: a preset picked in a combo (which drops the particles pinned by hand).
+bool pin_combo(const std::string& label, PinSpec* v) {
+    const int preset = static_cast<int>(v->preset);
+    const auto names = pin_preset_names();
+    const std::string preview =
+        std::string(names[preset]) + (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
+    bool edited = false;
+    if (ImGui::BeginCombo(label.c_str(), preview.c_str())) {
+        for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+            if (ImGui::Selectable(std::string(names[i]).c_str(), i == preset && v->particles.empty())) {
+                v->preset = static_cast<PinPreset>(i);
+                v->particles.clear();
+                edited = true;
+            }
+        }
+        ImGui::EndCombo();
+    }
+    return edited;
+}
+
+// Draws the widget for one field's value in `edit`; returns true when the user changed it.
+bool value_widget(Scene& edit, const FieldInfo& f) {
     const std::string label = label_of(f);
-    bool changed = std::visit(
+    return std::visit(
         Overloaded{
             [&](int* v) {
                 return ImGui::DragInt(label.c_str(), v, 0.2f, static_cast<int>(f.min), static_cast<int>(f.max), "%d",
                                       ImGuiSliderFlags_AlwaysClamp);
             },
-            [&](float* v) {
-                if (const SliderHint* h = hint_for(f.name)) {
-                    const bool edited = ImGui::SliderFloat(label.c_str(), v, h->lo, h->hi, "%.4g",
-                                                           h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
-                    *v = std::clamp(*v, static_cast<float>(f.min), static_cast<float>(f.max));
-                    return edited;
-                }
-                const float speed = std::max(std::fabs(*v) * 0.01f, 0.001f);
-                return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max),
-                                        "%.4g", ImGuiSliderFlags_AlwaysClamp);
-            },
+            [&](float* v) { return float_widget(label, f, v); },
             [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
             [&](glm::vec2* v) {
                 return ImGui::DragFloat2(label.c_str(), &v->x, 0.01f, static_cast<float>(f.min),
@@ -130,65 +152,58 @@ bool field_widget(AppState& app, const FieldInfo& f) {
                 }
                 return false;
             },
-            [&](PinSpec* v) {
-                int preset = static_cast<int>(v->preset);
-                const auto names = pin_preset_names();
-                const std::string preview =
-                    std::string(names[preset]) + (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
-                bool edited = false;
-                if (ImGui::BeginCombo(label.c_str(), preview.c_str())) {
-                    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
-                        if (ImGui::Selectable(std::string(names[i]).c_str(), i == preset && v->particles.empty())) {
-                            v->preset = static_cast<PinPreset>(i);
-                            v->particles.clear();
-                            edited = true;
-                        }
-                    }
-                    ImGui::EndCombo();
-                }
-                return edited;
-            },
+            [&](PinSpec* v) { return pin_combo(label, v); },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return enum_combo(label.c_str(), v, names_of(v)); },
         },
-        f.ref(app.scene));
-    tooltip(f);
+        f.ref(edit));
+}
 
-    // Reset: a small button once the value differs from the loaded scene's, and a right-click menu.
-    const std::string current = format_value(app.scene, f);
-    const std::string scene_value = format_value(app.loaded, f);
-    const std::string builtin = format_value(Scene{}, f);
+// Reset for the last widget: a right-click menu (the loaded scene's value or the built-in default), and a
+// small button once the value differs from the loaded scene's. Returns true when it reset the field.
+bool reset_controls(Scene& edit, const Scene& loaded, const FieldInfo& f) {
+    bool changed = false;
+    const std::string scene_value = format_value(loaded, f);
     if (ImGui::BeginPopupContextItem("reset")) {
         if (ImGui::MenuItem(("Reset to scene value " + scene_value).c_str())) {
-            copy_field(f, app.loaded, app.scene);
+            copy_field(f, loaded, edit);
             changed = true;
         }
-        if (ImGui::MenuItem(("Reset to built-in default " + builtin).c_str())) {
-            copy_field(f, Scene{}, app.scene);
+        if (ImGui::MenuItem(("Reset to built-in default " + format_value(Scene{}, f)).c_str())) {
+            copy_field(f, Scene{}, edit);
             changed = true;
         }
         ImGui::EndPopup();
     }
-    if (current != scene_value) {
+    if (format_value(edit, f) != scene_value) {
         ImGui::SameLine();
         if (ImGui::SmallButton("reset")) {
-            copy_field(f, app.loaded, app.scene);
+            copy_field(f, loaded, edit);
             changed = true;
         }
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the scene's value %s", scene_value.c_str());
     }
+    return changed;
+}
+
+// One field: its widget, its tooltip and its reset controls; returns true when the user changed it.
+bool field_widget(Scene& edit, const Scene& loaded, const FieldInfo& f) {
+    ImGui::PushID(f.name.data(), f.name.data() + f.name.size());
+    bool changed = value_widget(edit, f);
+    tooltip(f);
+    changed |= reset_controls(edit, loaded, f);
     ImGui::PopID();
     return changed;
 }
 
-// Draws every field whose name starts with `prefix`; returns true when any changed.
-bool fields_section(AppState& app, std::string_view prefix) {
+// Draws every field of `edit` whose name starts with `prefix`; returns true when any changed.
+bool fields_section(Scene& edit, const AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
         if (!f.name.starts_with(prefix)) continue;
         // Auto substeps owns the substeps field; greyed out so an edit is not silently overwritten.
-        const bool owned = app.auto_substeps && f.name == "integration.substeps";
+        const bool owned = app.stepper.policy().auto_substeps && f.name == "integration.substeps";
         if (owned) ImGui::BeginDisabled();
-        changed |= field_widget(app, f);
+        changed |= field_widget(edit, app.loaded, f);
         if (owned) ImGui::EndDisabled();
     }
     return changed;
@@ -283,6 +298,201 @@ float panel_width(const AppState& app, float content_scale) {
     return app.show_panel ? kPanelWidth * content_scale : 0.0f;
 }
 
+namespace {
+
+void status_line(const AppState& app) {
+    if (app.status.empty()) return;
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextColored(app.status_is_error ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
+                       app.status.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::Separator();
+}
+
+// Bundled scenes, open a file, play / step / reset, time scale, save.
+void scene_section(AppState& app, PanelRequests& requests) {
+    const std::vector<std::string> names = bundled_scene_names();
+    if (ImGui::BeginCombo("bundled", app.scene_source.c_str())) {
+        for (const std::string& n : names) {
+            if (ImGui::Selectable(n.c_str(), n == app.scene_source)) requests.load = n;
+        }
+        ImGui::EndCombo();
+    }
+    char open[512];
+    std::snprintf(open, sizeof open, "%s", app.open_path.c_str());
+    if (ImGui::InputText("##open", open, sizeof open)) app.open_path = open;
+    ImGui::SameLine();
+    if (ImGui::Button("Open file")) requests.load = app.open_path;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("load a .toml scene file; a bad file is rejected and nothing changes");
+    if (ImGui::Button(app.paused ? "Play (Space)" : "Pause (Space)")) app.paused = !app.paused;
+    ImGui::SameLine();
+    if (ImGui::Button("Step (S)")) {
+        app.paused = true;
+        app.step_once = true;
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Reset (R)")) requests.reset = true;
+    ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
+    char save[512];
+    std::snprintf(save, sizeof save, "%s", app.save_path.c_str());
+    if (ImGui::InputText("##save", save, sizeof save)) app.save_path = save;
+    ImGui::SameLine();
+    if (ImGui::Button("Save scene as")) requests.save = app.save_path;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the current settings as a scene file (atomically)");
+}
+
+// The forces' fields, and the wind as strength and heading, as a user thinks of it (both edit forces.wind).
+void forces_section(Scene& edit, const AppState& app) {
+    fields_section(edit, app, "forces.");
+    glm::vec3& wind = edit.settings.forces.wind;
+    float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
+    const float old_speed = speed;
+    if (ImGui::SliderFloat("wind speed", &speed, 0.0f, 50.0f, "%.2f m/s")) {
+        wind = old_speed > 0.0f ? wind * (speed / old_speed) : glm::vec3(speed, 0.0f, 0.0f);
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("|forces.wind| in m/s; keeps the direction");
+    float heading = std::atan2(wind.z, wind.x) * 57.29578f;
+    if (speed > 0.0f && ImGui::SliderFloat("wind heading", &heading, -180.0f, 180.0f, "%.0f deg")) {
+        const float horizontal = std::sqrt(wind.x * wind.x + wind.z * wind.z);
+        wind.x = horizontal * std::cos(heading / 57.29578f);
+        wind.z = horizontal * std::sin(heading / 57.29578f);
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
+}
+
+// The stability limit, where the current substep stands against it, and the auto choice (the stepper's).
+void stability_lines(AppState& app) {
+    bool auto_substeps = app.stepper.policy().auto_substeps;
+    if (ImGui::Checkbox("auto substeps", &auto_substeps)) app.stepper.set_auto_substeps(auto_substeps);
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("choose substeps every frame so the substep stays at the safety fraction of the\n"
+                          "critical substep (Gershgorin bound, docs/STABILITY.md)");
+    }
+    if (auto_substeps) {
+        ImGui::SameLine();
+        ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
+        float safety = app.stepper.policy().safety;
+        if (ImGui::SliderFloat("safety", &safety, 0.05f, 1.0f, "%.2f")) app.stepper.set_safety(safety);
+    }
+    const StabilityLimit& limit = app.stepper.limit(app.sim);
+    const IntegrationSettings& integration = app.sim.settings().integration;
+    const double substep = app.sim.substep_length();
+    if (limit.unconditionally_stable) {
+        ImGui::TextColored(ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "no explicit step limit (%s)",
+                           std::string(integrator_names()[static_cast<int>(integration.integrator)]).c_str());
+        return;
+    }
+    const double fraction = substep / limit.critical_substep;
+    const ImVec4 colour = fraction < 0.7   ? ImVec4(0.6f, 0.9f, 0.6f, 1.0f)
+                          : fraction < 1.0 ? ImVec4(1.0f, 0.85f, 0.3f, 1.0f)
+                                           : ImVec4(1.0f, 0.4f, 0.35f, 1.0f);
+    ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
+                1e3 * limit.plane_wave_substep);
+    ImGui::TextColored(colour, "substep %.4g ms = %.2f of critical%s", 1e3 * substep, fraction,
+                       auto_substeps ? " (auto)" : (fraction >= 1.0 ? ": may blow up" : ""));
+}
+
+void integration_section(Scene& edit, AppState& app) {
+    stability_lines(app);
+    fields_section(edit, app, "integration.");
+    fields_section(edit, app, "solver.");
+    int catchup = app.stepper.policy().max_catchup_steps;
+    if (ImGui::SliderInt("max catch-up steps", &catchup, 1, 16)) app.stepper.set_max_catchup_steps(catchup);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
+}
+
+void colliders_section(Scene& edit, const AppState& app) {
+    ImGui::TextDisabled("sphere");
+    fields_section(edit, app, "colliders.sphere.");
+    ImGui::Separator();
+    ImGui::TextDisabled("cube");
+    fields_section(edit, app, "colliders.cube.");
+    ImGui::Separator();
+    ImGui::TextDisabled("ground");
+    fields_section(edit, app, "colliders.ground.");
+    fields_section(edit, app, "colliders.thickness");
+}
+
+void view_section(AppState& app, PanelRequests& requests) {
+    ImGui::Checkbox("wireframe (W)", &app.view.wireframe);
+    int springs = static_cast<int>(app.view.springs);
+    ImGui::Combo("springs", &springs, "hidden\0by kind\0by strain\0");
+    app.view.springs = static_cast<SpringView>(springs);
+    if (app.view.springs == SpringView::ByKind) {
+        ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.2f, 1.0f), "structural");
+        ImGui::SameLine();
+        ImGui::TextColored(ImVec4(0.2f, 0.85f, 1.0f, 1.0f), "shear");
+        ImGui::SameLine();
+        ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.9f, 1.0f), "bending");
+    }
+    if (app.view.springs == SpringView::ByStrain) {
+        ImGui::SliderFloat("strain range", &app.view.strain_range, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
+        ImGui::TextDisabled("blue compressed, white at rest, red stretched");
+    }
+    ImGui::Checkbox("particles", &app.view.particles);
+    ImGui::Checkbox("highlight pinned particles", &app.view.highlight_pins);
+    ImGui::Checkbox("fabric texture", &app.view.texture);
+    ImGui::Checkbox("shadows", &app.view.shadows);
+    ImGui::Checkbox("vsync", &app.vsync);
+    if (ImGui::Button("Frame cloth (F)")) requests.frame_camera = true;
+    ImGui::SameLine();
+    if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;
+}
+
+void stats_section(const AppState& app) {
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::Text("%.0f FPS (%.2f ms per frame)", io.Framerate, 1000.0f / std::max(io.Framerate, 1e-3f));
+    ImGui::Text("simulation %.2f ms (%lld substeps), render %.2f ms", app.stats.sim_ms, app.stats.substeps_last_frame,
+                app.stats.render_ms);
+    ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
+                app.sim.time());
+    // The fast solver runs position Verlet; every other integrator uses the shared textbook force path.
+    const bool fast = app.sim.plan().path == StepPath::FastSweep;
+    const double per_substep_us = app.stats.substeps_last_frame > 0
+                                      ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
+                                      : 0.0;
+    if (fast) {
+        ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep", MassSpring::fast_kernel_name(),
+                    app.sim.solver_threads(), app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
+    } else {
+        ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);
+    }
+    if (app.stats.dropped_seconds > 0.0) {
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
+                           app.stats.dropped_seconds);
+    }
+    // Accuracy hint: how much total energy moved over the plotted window. With no damping, no wind and no
+    // contact it should stay put, and its drift measures the integrator's error at this step.
+    const Integrator integrator = app.sim.settings().integration.integrator;
+    ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
+                integrator == Integrator::ImplicitEuler
+                    ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations").c_str()
+                    : "");
+    if (app.stats.total.size() > 1) {
+        const History& e = app.stats.total;
+        const float first = e.values[static_cast<std::size_t>(e.offset())];
+        const float drift = (e.last() - first) / std::max(std::fabs(first), 1e-6f);
+        const bool conservative = app.sim.settings().springs.damping == 0.0f &&
+                                  app.sim.settings().forces.wind == glm::vec3(0.0f);
+        ImGui::TextColored(conservative && std::fabs(drift) > 0.01f ? ImVec4(1.0f, 0.6f, 0.3f, 1.0f)
+                                                                    : ImVec4(0.8f, 0.8f, 0.8f, 1.0f),
+                           "energy drift over the plot: %+.3g%%%s", 100.0 * drift,
+                           conservative ? " (error)" : "");
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("relative change of total energy over the last %d frames; with no damping,\n"
+                              "wind or contact it is integration error. docs/ACCURACY.md compares the\n"
+                              "integrators' errors against run time.",
+                              e.size());
+        }
+    }
+    plot("kinetic", app.stats.kinetic, ImVec4(1.0f, 0.6f, 0.3f, 1.0f));
+    plot("potential", app.stats.potential, ImVec4(0.4f, 0.7f, 1.0f, 1.0f));
+    plot("total", app.stats.total, ImVec4(0.9f, 0.9f, 0.9f, 1.0f));
+}
+
+}  // namespace
+
 PanelRequests draw_panel(AppState& app, float content_scale) {
     PanelRequests requests;
     const ImGuiViewport* viewport = ImGui::GetMainViewport();
@@ -291,189 +501,24 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     ImGui::SetNextWindowBgAlpha(0.92f);
     ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     ImGui::PushItemWidth(-ImGui::GetFontSize() * 8.5f);
-
-    if (!app.status.empty()) {
-        ImGui::PushTextWrapPos(0.0f);
-        ImGui::TextColored(app.status_is_error ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
-                           app.status.c_str());
-        ImGui::PopTextWrapPos();
-        ImGui::Separator();
-    }
-
-    if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const std::vector<std::string> names = bundled_scene_names();
-        if (ImGui::BeginCombo("bundled", app.scene_source.c_str())) {
-            for (const std::string& n : names) {
-                if (ImGui::Selectable(n.c_str(), n == app.scene_source)) requests.load = n;
-            }
-            ImGui::EndCombo();
-        }
-        char open[512];
-        std::snprintf(open, sizeof open, "%s", app.open_path.c_str());
-        if (ImGui::InputText("##open", open, sizeof open)) app.open_path = open;
-        ImGui::SameLine();
-        if (ImGui::Button("Open file")) requests.load = app.open_path;
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("load a .toml scene file; a bad file is rejected and nothing changes");
-        if (ImGui::Button(app.paused ? "Play (Space)" : "Pause (Space)")) app.paused = !app.paused;
-        ImGui::SameLine();
-        if (ImGui::Button("Step (S)")) {
-            app.paused = true;
-            app.step_once = true;
-        }
-        ImGui::SameLine();
-        if (ImGui::Button("Reset (R)")) requests.reset = true;
-        ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic);
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
-        char save[512];
-        std::snprintf(save, sizeof save, "%s", app.save_path.c_str());
-        if (ImGui::InputText("##save", save, sizeof save)) app.save_path = save;
-        ImGui::SameLine();
-        if (ImGui::Button("Save scene as")) requests.save = app.save_path;
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the current settings as a scene file (atomically)");
-    }
+    status_line(app);
+    // The widgets edit a copy of the running scene; a settings change reaches the simulation through its
+    // one call (MassSpring::apply), a cloth or pin change rebuilds the cloth after this frame.
+    Scene edit = app.document();
+    if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) scene_section(app, requests);
     if (ImGui::CollapsingHeader("Cloth")) {
         ImGui::TextDisabled("changes rebuild the cloth");
-        requests.rebuild |= fields_section(app, "cloth.");
-        requests.rebuild |= fields_section(app, "pins");
+        requests.rebuild |= fields_section(edit, app, "cloth.");
+        requests.rebuild |= fields_section(edit, app, "pins");
     }
-    if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(app, "springs.");
-    if (ImGui::CollapsingHeader("Forces")) {
-        fields_section(app, "forces.");
-        // Strength and direction as a user thinks of them; both edit forces.wind.
-        glm::vec3& wind = app.scene.settings.forces.wind;
-        float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
-        const float old_speed = speed;
-        if (ImGui::SliderFloat("wind speed", &speed, 0.0f, 50.0f, "%.2f m/s")) {
-            wind = old_speed > 0.0f ? wind * (speed / old_speed) : glm::vec3(speed, 0.0f, 0.0f);
-        }
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("|forces.wind| in m/s; keeps the direction");
-        float heading = std::atan2(wind.z, wind.x) * 57.29578f;
-        if (speed > 0.0f && ImGui::SliderFloat("wind heading", &heading, -180.0f, 180.0f, "%.0f deg")) {
-            const float horizontal = std::sqrt(wind.x * wind.x + wind.z * wind.z);
-            wind.x = horizontal * std::cos(heading / 57.29578f);
-            wind.z = horizontal * std::sin(heading / 57.29578f);
-        }
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
-    }
-    if (ImGui::CollapsingHeader("Integration", ImGuiTreeNodeFlags_DefaultOpen)) {
-        // Stability: the critical substep, where this one stands against it, and the auto choice.
-        ImGui::Checkbox("auto substeps", &app.auto_substeps);
-        if (ImGui::IsItemHovered()) {
-            ImGui::SetTooltip("choose substeps every frame so the substep stays at the safety fraction of the\n"
-                              "critical substep (Gershgorin bound, docs/STABILITY.md)");
-        }
-        if (app.auto_substeps) {
-            ImGui::SameLine();
-            ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
-            ImGui::SliderFloat("safety", &app.safety, 0.05f, 1.0f, "%.2f");
-        }
-        const StabilityLimit& limit = app.limit;
-        const double substep = double(app.scene.settings.integration.dt) / app.scene.settings.integration.substeps;
-        if (limit.unconditionally_stable) {
-            ImGui::TextColored(ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "no explicit step limit (%s)",
-                               std::string(integrator_names()[static_cast<int>(app.scene.settings.integration.integrator)]).c_str());
-        } else {
-            const double fraction = substep / limit.critical_substep;
-            const ImVec4 colour = fraction < 0.7   ? ImVec4(0.6f, 0.9f, 0.6f, 1.0f)
-                                  : fraction < 1.0 ? ImVec4(1.0f, 0.85f, 0.3f, 1.0f)
-                                                   : ImVec4(1.0f, 0.4f, 0.35f, 1.0f);
-            ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
-                        1e3 * limit.plane_wave_substep);
-            ImGui::TextColored(colour, "substep %.4g ms = %.2f of critical%s", 1e3 * substep, fraction,
-                               app.auto_substeps ? " (auto)" : (fraction >= 1.0 ? ": may blow up" : ""));
-        }
-        fields_section(app, "integration.");
-        fields_section(app, "solver.");
-        ImGui::SliderInt("max catch-up steps", &app.max_catchup_steps, 1, 16);
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
-    }
-    if (ImGui::CollapsingHeader("Colliders")) {
-        ImGui::TextDisabled("sphere");
-        fields_section(app, "colliders.sphere.");
-        ImGui::Separator();
-        ImGui::TextDisabled("cube");
-        fields_section(app, "colliders.cube.");
-        ImGui::Separator();
-        ImGui::TextDisabled("ground");
-        fields_section(app, "colliders.ground.");
-        fields_section(app, "colliders.thickness");
-    }
-    if (ImGui::CollapsingHeader("View")) {
-        ImGui::Checkbox("wireframe (W)", &app.view.wireframe);
-        int springs = static_cast<int>(app.view.springs);
-        ImGui::Combo("springs", &springs, "hidden\0by kind\0by strain\0");
-        app.view.springs = static_cast<SpringView>(springs);
-        if (app.view.springs == SpringView::ByKind) {
-            ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.2f, 1.0f), "structural");
-            ImGui::SameLine();
-            ImGui::TextColored(ImVec4(0.2f, 0.85f, 1.0f, 1.0f), "shear");
-            ImGui::SameLine();
-            ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.9f, 1.0f), "bending");
-        }
-        if (app.view.springs == SpringView::ByStrain) {
-            ImGui::SliderFloat("strain range", &app.view.strain_range, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
-            ImGui::TextDisabled("blue compressed, white at rest, red stretched");
-        }
-        ImGui::Checkbox("particles", &app.view.particles);
-        ImGui::Checkbox("highlight pinned particles", &app.view.highlight_pins);
-        ImGui::Checkbox("fabric texture", &app.view.texture);
-        ImGui::Checkbox("shadows", &app.view.shadows);
-        ImGui::Checkbox("vsync", &app.vsync);
-        if (ImGui::Button("Frame cloth (F)")) requests.frame_camera = true;
-        ImGui::SameLine();
-        if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;
-    }
-    if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const ImGuiIO& io = ImGui::GetIO();
-        ImGui::Text("%.0f FPS (%.2f ms per frame)", io.Framerate, 1000.0f / std::max(io.Framerate, 1e-3f));
-        ImGui::Text("simulation %.2f ms (%lld substeps), render %.2f ms", app.stats.sim_ms, app.stats.substeps_last_frame,
-                    app.stats.render_ms);
-        ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
-                    app.sim.time());
-        // The fast solver runs position Verlet; every other integrator uses the shared textbook force path.
-        const bool fast = app.sim.fast_solver_available() && app.scene.settings.solver.method == SolverMethod::Fast &&
-                          app.scene.settings.integration.integrator == Integrator::Verlet;
-        const double per_substep_us = app.stats.substeps_last_frame > 0
-                                          ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
-                                          : 0.0;
-        if (fast) {
-            ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep", MassSpring::fast_kernel_name(),
-                        app.sim.solver_threads(), app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
-        } else {
-            ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);
-        }
-        if (app.stats.dropped_seconds > 0.0) {
-            ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
-                               app.stats.dropped_seconds);
-        }
-        // Accuracy hint: how much total energy moved over the plotted window. With no damping, no wind and no
-        // contact it should stay put, and its drift measures the integrator's error at this step.
-        const Integrator integrator = app.scene.settings.integration.integrator;
-        ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
-                    integrator == Integrator::ImplicitEuler
-                        ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations").c_str()
-                        : "");
-        if (app.stats.total.size() > 1) {
-            const History& e = app.stats.total;
-            const float first = e.values[static_cast<std::size_t>(e.offset())];
-            const float drift = (e.last() - first) / std::max(std::fabs(first), 1e-6f);
-            const bool conservative = app.scene.settings.springs.damping == 0.0f &&
-                                      app.scene.settings.forces.wind == glm::vec3(0.0f);
-            ImGui::TextColored(conservative && std::fabs(drift) > 0.01f ? ImVec4(1.0f, 0.6f, 0.3f, 1.0f)
-                                                                        : ImVec4(0.8f, 0.8f, 0.8f, 1.0f),
-                               "energy drift over the plot: %+.3g%%%s", 100.0 * drift,
-                               conservative ? " (error)" : "");
-            if (ImGui::IsItemHovered()) {
-                ImGui::SetTooltip("relative change of total energy over the last %d frames; with no damping,\n"
-                                  "wind or contact it is integration error. docs/ACCURACY.md compares the\n"
-                                  "integrators' errors against run time.",
-                                  e.size());
-            }
-        }
-        plot("kinetic", app.stats.kinetic, ImVec4(1.0f, 0.6f, 0.3f, 1.0f));
-        plot("potential", app.stats.potential, ImVec4(0.4f, 0.7f, 1.0f, 1.0f));
-        plot("total", app.stats.total, ImVec4(0.9f, 0.9f, 0.9f, 1.0f));
-    }
+    if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(edit, app, "springs.");
+    if (ImGui::CollapsingHeader("Forces")) forces_section(edit, app);
+    if (ImGui::CollapsingHeader("Integration", ImGuiTreeNodeFlags_DefaultOpen)) integration_section(edit, app);
+    if (ImGui::CollapsingHeader("Colliders")) colliders_section(edit, app);
+    app.sim.apply(edit.settings);
+    app.scene = edit;
+    if (ImGui::CollapsingHeader("View")) view_section(app, requests);
+    if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_section(app);
     if (ImGui::CollapsingHeader("Profile", ImGuiTreeNodeFlags_DefaultOpen)) profile_section(app);
     if (ImGui::CollapsingHeader("Help")) help_section();
     ImGui::PopItemWidth();

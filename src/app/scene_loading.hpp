@@ -15,4 +15,12 @@ namespace clothsim {
 // and leaves them untouched.
 std::optional<std::string> open_scene(const std::string& source, Scene& edited, Scene& loaded, MassSpring& sim);
 
+// The scene as it runs, what "Save scene as" writes: the document (name, cloth and pins as edited) with
+// the simulation's live settings, which only the simulation holds.
+inline Scene running_scene(const Scene& document, const MassSpring& sim) {
+    Scene running = document;
+    running.settings = sim.settings();
+    return running;
+}
+
 }  // namespace clothsim

@@ -61,6 +61,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
             substep_length());
     stamp_ = next_stamp();
+    setup_stamp_ = next_stamp();
 }
 
 MassSpring::~MassSpring() = default;
@@ -81,14 +82,23 @@ float MassSpring::substep_length() const {
     return settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
 }
 
-// The whole pipeline of one substep, in order. The stages come from the plan (step_plan.hpp), made again
-// here when the settings have changed since; a stage the plan leaves out is not run, not even as a branch
-// per particle.
+void MassSpring::apply(const SimulationSettings& settings) {
+    if (settings == settings_) return;
+    settings_ = settings;
+    replan();
+    wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
+    setup_stamp_ = next_stamp();
+}
+
+void MassSpring::set_substeps(int substeps) {
+    SimulationSettings s = settings_;
+    s.integration.substeps = substeps;
+    apply(s);
+}
+
+// The whole pipeline of one substep, in order. The stages come from the plan (step_plan.hpp), made when the
+// settings were applied; a stage the plan leaves out is not run, not even as a branch per particle.
 void MassSpring::step() {
-    if (!(settings_ == planned_)) {
-        replan();
-        wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
-    }
     const float h = substep_length();
     if (asleep_) {
         state_.time += h;
@@ -175,7 +185,6 @@ void MassSpring::collide(StepProfile* profile) {
 
 void MassSpring::replan() {
     plan_ = plan_step(topology_, settings_, grid_.solver != nullptr);
-    planned_ = settings_;
 }
 
 void MassSpring::wake() {
@@ -302,16 +311,6 @@ void MassSpring::run_steps(long long steps) {
     }
 }
 
-long long MassSpring::advance(double seconds) {
-    carry_ += seconds;
-    const double h = substep_length();
-    // The small tolerance keeps 1/60 s from becoming 9.9999 substeps of 1/600 s through rounding.
-    const auto n = static_cast<long long>(std::floor(carry_ / h + 1e-6));
-    for (long long i = 0; i < n; ++i) step();
-    carry_ = std::max(0.0, carry_ - static_cast<double>(n) * h);
-    return n;
-}
-
 void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
     const Integrator integrator = settings_.integration.integrator;
     state_.integrator = static_cast<int>(integrator);
@@ -388,6 +387,7 @@ bool MassSpring::all_finite() const {
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
     wake();
     stamp_ = next_stamp();
+    setup_stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? 1 : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::vec3(0.0f));

@@ -155,7 +155,7 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
                 return false;
             }
             sim = good;
-            sim.settings().integration.substeps = std::min(2 * substeps, kMaxSubsteps);
+            sim.set_substeps(std::min(2 * substeps, kMaxSubsteps));
             std::snprintf(line, sizeof line,
                           "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
                           "from %d to %d\n",

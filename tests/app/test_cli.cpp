@@ -487,3 +487,29 @@ TEST_CASE("cli: --print-scene prints the scene after --set as TOML that loads ba
     CHECK(back.cloth.rows == 7);
     CHECK(clothsim::to_toml(back) == r.out);
 }
+
+TEST_CASE("cli: --json reports the substeps that ran: auto substeps' choice and the guard's") {
+    // Auto substeps on a 64 x 64 hanging cloth: the count said on stderr is the count in the JSON.
+    const RunResult automatic = run_clothsim({"--headless", "--scene", "hanging", "--set", "cloth.rows=64", "--set",
+                                              "cloth.cols=64", "--auto-substeps", "0.5", "--steps", "2", "--json"});
+    CAPTURE_RUN(automatic);
+    REQUIRE(automatic.code == 0);
+    const nlohmann::json a = nlohmann::json::parse(automatic.out);
+    const int chosen = a.at("substeps_per_step").get<int>();
+    CHECK(chosen != clothsim::load_scene("hanging").settings.integration.substeps);
+    CHECK_THAT(automatic.err, Contains(", " + std::to_string(chosen) + " substeps per step"));
+    CHECK(a.at("substep").get<double>() <= 0.5 * a.at("critical_substep").get<double>() * (1.0 + 1e-6));
+
+    // One substep of 16.7 ms blows up: the guard doubles until it holds, and the JSON says what ran.
+    const RunResult guarded = run_clothsim({"--headless", "--scene", "hanging", "--set", "integration.substeps=1",
+                                            "--guard", "--steps", "3", "--json"});
+    CAPTURE_RUN(guarded);
+    REQUIRE(guarded.code == 0);
+    const nlohmann::json g = nlohmann::json::parse(guarded.out);
+    const int doubled = g.at("substeps_per_step").get<int>();
+    CHECK(doubled >= 16);
+    CHECK((doubled & (doubled - 1)) == 0);  // a power of two: doubled from 1
+    CHECK_THAT(g.at("guard_log").get<std::string>(),
+               Contains("to " + std::to_string(doubled)) && Contains("from 1 to 2"));
+    CHECK(g.at("substep").get<double>() == Approx(g.at("dt").get<double>() / doubled).epsilon(1e-6));
+}

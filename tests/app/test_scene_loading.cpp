@@ -1,6 +1,8 @@
 // open_scene: what the panel's Open does. A rejected file changes nothing the user has.
 #include "scene_loading.hpp"
 
+#include "support.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -74,4 +76,45 @@ TEST_CASE("open_scene: a good file replaces the edited scene, the reset target a
     CHECK(s.loaded.name == "small");
     CHECK(s.sim.particle_count() == 6);
     CHECK(s.sim.time() == 0.0);
+}
+
+TEST_CASE("running_scene: a panel change reaches the next substep and is what Save writes") {
+    // What the panel does with an edit: the simulation's one call, MassSpring::apply.
+    Scene document = load_scene("hanging");
+    // One substep per step: a long substep makes the first fall (g h^2) large against float round-off.
+    document.settings.integration.substeps = 1;
+    MassSpring sim = build_simulation(document);
+    MassSpring earth = sim;
+    MassSpring weightless = sim;
+    SimulationSettings edit = sim.settings();
+    edit.forces.gravity = {0.0f, -1.62f, 0.0f};  // the Moon
+    edit.springs.structural = 250.0f;
+    sim.apply(edit);
+    CHECK(sim.settings().forces.gravity.y == -1.62f);
+    test::edit_settings(weightless, [](SimulationSettings& s) {
+        s.forces.gravity = glm::vec3(0.0f);
+        s.springs.structural = 250.0f;
+    });
+    test::edit_settings(earth, [](SimulationSettings& s) { s.springs.structural = 250.0f; });
+
+    // The next substep runs with it: against the same cloth without gravity, a free corner has fallen in
+    // proportion to g (the first substep is linear in gravity).
+    const std::size_t corner = sim.particle_count() - 1;
+    REQUIRE_FALSE(sim.particle(corner).pinned);
+    sim.step();
+    earth.step();
+    weightless.step();
+    const double moon_drop = weightless.position(corner).y - sim.position(corner).y;
+    const double earth_drop = weightless.position(corner).y - earth.position(corner).y;
+    REQUIRE(earth_drop > 0.0);
+    CHECK(moon_drop / earth_drop == Approx(1.62 / 9.81).epsilon(1e-3));
+
+    // Save writes what runs, and the file loads back to exactly those settings.
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / "clothsim_running_scene.toml";
+    std::ofstream(path) << to_toml(running_scene(document, sim));
+    const Scene saved = load_scene(path.string());
+    std::filesystem::remove(path);
+    CHECK(saved.settings == sim.settings());
+    CHECK(saved.settings.springs.structural == 250.0f);
+    CHECK(saved.cloth.rows == document.cloth.rows);
 }

@@ -93,7 +93,7 @@ TEST_CASE("integrators switching mid-run keeps position and velocity", "[integra
     for (Integrator next : {Integrator::Rk4, Integrator::SymplecticEuler, Integrator::ImplicitEuler,
                             Integrator::Xpbd, Integrator::Verlet}) {
         sim.run_steps(100);
-        sim.settings().integration.integrator = next;
+        test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = next; });
     }
     sim.run_steps(100);  // 0.6 s of free fall through five integrators
     CHECK(sim.velocities()[0].y == Approx(-9.81 * 0.6).epsilon(2e-3));

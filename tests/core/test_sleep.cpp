@@ -134,7 +134,7 @@ TEST_CASE("sleep only freezes a cloth that was slower than sleep_speed for the w
         // A copy that may not sleep shows the motion the step leaves before sleeping zeroes it (sleep_speed
         // changes nothing else: it does not enter the physics).
         MassSpring probe = sim;
-        probe.settings().solver.sleep_speed = 0.0f;
+        test::edit_settings(probe, [&](SimulationSettings& edit) { edit.solver.sleep_speed = 0.0f; });
         probe.run_steps(1);
         const std::vector<glm::vec3> before = sim.positions();
         const double t0 = sim.time();
@@ -279,8 +279,9 @@ TEST_CASE("sleep with sleep_speed 0 a cloth at rest never sleeps", "[sleep]") {
 TEST_CASE("sleep wind wakes a sleeping cloth and keeps it awake while it blows", "[sleep]") {
     MassSpring sim = asleep_cloth();
     const std::vector<glm::vec3> held = sim.positions();
-    sim.settings().forces.wind = {0.0f, 0.0f, 3.0f};  // across the hanging cloth (it hangs in the x-y plane)
-    CHECK_FALSE(sim.resting());  // a change is waiting
+    // Across the hanging cloth (it hangs in the x-y plane); the change wakes it at once.
+    test::edit_settings(sim, [](SimulationSettings& edit) { edit.forces.wind = {0.0f, 0.0f, 3.0f}; });
+    CHECK_FALSE(sim.resting());
     sim.run_steps(1);
     CHECK_FALSE(sim.asleep());
     CHECK_FALSE(sim.plan().may_sleep);
@@ -324,7 +325,7 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
         const std::vector<glm::vec3> held = sim.positions();
         float lowest = INFINITY;
         for (const glm::vec3& p : held) lowest = std::min(lowest, p.y);
-        sim.settings().colliders.ground.height = lowest + 0.05f;
+        test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.ground.height = lowest + 0.05f; });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
         CHECK(largest_move(sim, held) > 0.04f);
@@ -336,14 +337,15 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
         settle(sim);
         const std::vector<glm::vec3> held = sim.positions();
         const glm::vec3 middle = held[sim.topology().index(4, 4)];
-        sim.settings().colliders.sphere.center = middle + glm::vec3(0.0f, 0.0f, 0.15f);
+        test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.sphere.center = middle + glm::vec3(0.0f, 0.0f, 0.15f); });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
         CHECK(largest_move(sim, held) > 0.01f);
     }
     SECTION("a collider moved out of reach still wakes it") {
         MassSpring sim = asleep_cloth();
-        sim.settings().colliders.sphere.center.x += 1.0f;  // disabled sphere: nothing touches the cloth
+        // A disabled sphere: nothing touches the cloth.
+        test::edit_settings(sim, [](SimulationSettings& edit) { edit.colliders.sphere.center.x += 1.0f; });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
     }
@@ -351,33 +353,33 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
 
 TEST_CASE("sleep any settings change wakes a sleeping cloth and no change keeps it asleep", "[sleep]") {
     MassSpring sim = asleep_cloth();
-    sim.settings().springs.bending = sim.settings().springs.bending;  // the same value: no change
+    sim.apply(sim.settings());  // the same values: no change
     CHECK(sim.resting());
     sim.run_steps(3);
     CHECK(sim.asleep());
 
-    sim.settings().springs.bending *= 2.0f;
+    test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.bending *= 2.0f; });
     CHECK_FALSE(sim.resting());
-    CHECK(sim.asleep());  // not before the next step
+    CHECK_FALSE(sim.asleep());  // woken at the point of change
     sim.step();
     CHECK_FALSE(sim.asleep());
 
     MassSpring heavier = asleep_cloth();
     const std::vector<glm::vec3> held = heavier.positions();
-    heavier.settings().forces.gravity.y *= 2.0f;
+    test::edit_settings(heavier, [&](SimulationSettings& edit) { edit.forces.gravity.y *= 2.0f; });
     heavier.run_steps(10);
     CHECK_FALSE(heavier.asleep());
     CHECK(largest_move(heavier, held) > 1e-3f);  // it sags under the stronger gravity
 
     MassSpring damped = asleep_cloth();
-    damped.settings().springs.damping = 5.0f;
+    test::edit_settings(damped, [&](SimulationSettings& edit) { edit.springs.damping = 5.0f; });
     damped.step();
     CHECK_FALSE(damped.asleep());
 }
 
 TEST_CASE("sleep a woken cloth restarts from rest exactly as a fresh cloth at those positions", "[sleep]") {
     MassSpring sim = asleep_cloth();
-    sim.settings().forces.gravity.y = -5.0f;  // the change that wakes it
+    test::edit_settings(sim, [](SimulationSettings& edit) { edit.forces.gravity.y = -5.0f; });  // the change that wakes it
     // A fresh simulation of the same cloth, at the same positions, started at rest with the new settings.
     MassSpring fresh(sim.topology(), sim.state(), sim.settings());
     sim.step();  // wakes, restarts from rest and integrates one substep
@@ -421,8 +423,8 @@ TEST_CASE("sleep a copy of a sleeping cloth is asleep and steps identically", "[
     require_same_positions(sim, copy);
     CHECK(copy.time() == sim.time());
     // Woken alike, they go on alike.
-    sim.settings().forces.wind = {2.0f, 0.0f, 1.0f};
-    copy.settings().forces.wind = {2.0f, 0.0f, 1.0f};
+    test::edit_settings(sim, [&](SimulationSettings& edit) { edit.forces.wind = {2.0f, 0.0f, 1.0f}; });
+    test::edit_settings(copy, [&](SimulationSettings& edit) { edit.forces.wind = {2.0f, 0.0f, 1.0f}; });
     sim.run_steps(30);
     copy.run_steps(30);
     CHECK_FALSE(copy.asleep());

@@ -76,8 +76,7 @@ std::string override_error(Scene& scene, const std::string& assignment) {
 
 // Sets integration.substeps from the predicted limit (safety 0.5) and runs `steps` steps.
 void run_auto(MassSpring& sim, long long steps, float safety = 0.5f) {
-    sim.settings().integration.substeps =
-        auto_substeps(stability_limit(sim), sim.settings().integration.dt, safety, 1);
+    sim.set_substeps(auto_substeps(stability_limit(sim), sim.settings().integration.dt, safety, 1));
     sim.run_steps(steps);
 }
 
@@ -898,7 +897,7 @@ TEST_CASE("stability damping limits the explicit parts of XPBD and RK4, and auto
         INFO("integrator " << int(integrator) << ", damping " << damping << ": critical " << limit.critical_substep);
         CHECK_FALSE(limit.unconditionally_stable);
         CHECK(limit.critical_substep * damping <= 2.785 + 1e-9);
-        sim.settings().integration.substeps = auto_substeps(limit, s.settings.integration.dt, 0.5f);
+        sim.set_substeps(auto_substeps(limit, sim.settings().integration.dt, 0.5f));
         sim.run_steps(20);
         CHECK(sim.all_finite());
         CHECK(std::isfinite(sim.energy().total()));

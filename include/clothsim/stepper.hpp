@@ -1,0 +1,70 @@
+// The run policy: how time becomes steps of a MassSpring. The caller owns time (as in b2World_Step); the
+// Stepper decides how many whole steps of integration.dt to run and with how many substeps, in one place
+// that the desktop app and --headless both use:
+//  - fixed step: advance() adds simulated seconds to an accumulator and runs the whole steps it holds, at most
+//    max_catchup_steps per call, so a slow frame slows the simulation instead of spiralling (Fiedler, "Fix
+//    Your Timestep!", 2004); run() runs an exact number of steps (a single step, a scripted frame, a headless
+//    run);
+//  - auto substeps: before stepping, integration.substeps is chosen so the substep is `safety` times the
+//    critical substep of the current cloth (stability.hpp, docs/STABILITY.md);
+//  - the guard: a step that blows up is rolled back and retried with twice the substeps (run_guarded). Auto
+//    substeps then yields to the guard's choice (it is turned off), so the next step does not fall back to
+//    the substep that failed.
+#pragma once
+
+#include "clothsim/mass_spring.hpp"
+#include "clothsim/stability.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace clothsim {
+
+struct RunPolicy {
+    bool auto_substeps = false;  // choose integration.substeps from the critical substep before stepping
+    float safety = 0.5f;         // ... so the substep is this fraction of it, in (0, 1]
+    bool guard = false;          // roll back and retry with doubled substeps when a step blows up
+    GuardSettings guard_settings;
+    int max_catchup_steps = 4;   // advance(): steps per call at most; the rest of the time is dropped
+};
+
+// What one advance() or run() did.
+struct StepReport {
+    long long steps = 0;           // steps run
+    double dropped_seconds = 0.0;  // simulated time dropped by the catch-up cap
+    bool skipped_non_finite = false;  // nothing was stepped: the cloth is already non-finite
+    bool guard_gave_up = false;    // the guard ran out of retries: the cloth is at the last good state
+    std::string guard_log;         // the guard's changes and auto substeps turned off, one line each
+};
+
+class Stepper {
+public:
+    explicit Stepper(RunPolicy policy = {}) : policy_(policy) {}
+
+    const RunPolicy& policy() const { return policy_; }
+    void set_auto_substeps(bool on) { policy_.auto_substeps = on; }
+    void set_safety(float safety) { policy_.safety = safety; }
+    void set_max_catchup_steps(int steps) { policy_.max_catchup_steps = steps; }
+
+    // Adds `seconds` of simulated time and runs the whole steps of integration.dt it makes up (with what
+    // earlier calls left over), at most max_catchup_steps of them.
+    StepReport advance(MassSpring& sim, double seconds);
+    // Runs `steps` steps now.
+    StepReport run(MassSpring& sim, long long steps);
+    // Forgets the time owed (a new cloth, a reset).
+    void restart() { accumulator_ = 0.0; }
+
+    // Chooses integration.substeps when auto substeps is on (run() and advance() do this before stepping);
+    // returns the substeps in force.
+    int choose_substeps(MassSpring& sim);
+    // The stability limit of `sim` as it is now (kept until sim.setup_stamp() changes).
+    const StabilityLimit& limit(const MassSpring& sim);
+
+private:
+    RunPolicy policy_;
+    double accumulator_ = 0.0;       // s of simulated time owed
+    StabilityLimit limit_;
+    std::uint64_t limit_stamp_ = 0;  // the setup_stamp limit_ was computed for (0: none)
+};
+
+}  // namespace clothsim

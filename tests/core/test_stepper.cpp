@@ -1,0 +1,183 @@
+// The Stepper: the run policy the app and --headless share (fixed step, catch-up cap, auto substeps, the
+// guard), and results bit-identical to the stepping that came before it.
+#include "clothsim/scene.hpp"
+#include "clothsim/stepper.hpp"
+
+#include "support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <string>
+
+using namespace clothsim;
+
+namespace {
+
+// FNV-1a over the bytes of every position.
+unsigned long long position_hash(const MassSpring& sim) {
+    unsigned long long h = 1469598103934665603ull;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::vec3 p = sim.position(i);
+        unsigned char bytes[sizeof p];
+        std::memcpy(bytes, &p, sizeof p);
+        for (unsigned char c : bytes) {
+            h ^= c;
+            h *= 1099511628211ull;
+        }
+    }
+    return h;
+}
+
+// Recorded before the Stepper existed (MassSpring::run_steps; and the app's loop: auto substeps at 0.5 of
+// the critical substep before each step, then run_guarded for one step), 60 steps of every bundled scene.
+struct Recorded {
+    const char* scene;
+    unsigned long long plain, app;
+    int app_substeps;
+};
+constexpr Recorded kRecorded[] = {
+    {"curtain", 0xa7e46830ba3dc3daull, 0xc3e78c1f741acfbbull, 49},
+    {"drape-cube", 0xd085bda2a8c2060aull, 0x25d2f889bcd149d5ull, 52},
+    {"drape-sphere", 0x44c218ae5c134096ull, 0xf598ba9435e92eb5ull, 52},
+    {"falling", 0x011c4ffae1c23cb5ull, 0x7d5e48dff1dbff80ull, 46},
+    {"flag", 0xd2ed83e685233ce1ull, 0xda44dff5046348e8ull, 54},
+    {"hanging", 0xd7dfde12ef141aeeull, 0xa6ece19af378e992ull, 46},
+};
+
+// The same, 10 steps of drape-sphere with each other path and integrator.
+struct RecordedVariant {
+    const char* set;
+    unsigned long long plain;
+};
+constexpr RecordedVariant kRecordedVariants[] = {
+    {"solver.method=textbook", 0x96826ff50d64ef03ull},
+    {"integration.integrator=symplectic-euler", 0x38cf1bd3452e52c3ull},
+    {"integration.integrator=rk4", 0xac9301546dd45423ull},
+    {"integration.integrator=implicit-euler", 0xfcc2d7124fe4c203ull},
+    {"integration.integrator=xpbd", 0x805339ebd96e70c3ull},
+};
+
+MassSpring hanging(float dt = 0.01f) {
+    Scene s = load_scene("hanging");
+    s.settings.integration.dt = dt;
+    return build_simulation(s);
+}
+
+}  // namespace
+
+TEST_CASE("stepper every bundled scene runs bit-identically to the recorded positions", "[stepper]") {
+    for (const Recorded& r : kRecorded) {
+        INFO("scene " << r.scene);
+        const Scene scene = load_scene(r.scene);
+        MassSpring plain = build_simulation(scene);
+        plain.run_steps(60);
+        CHECK(position_hash(plain) == r.plain);
+
+        RunPolicy policy;
+        policy.auto_substeps = true;
+        policy.safety = 0.5f;
+        policy.guard = true;
+        Stepper stepper(policy);
+        MassSpring app = build_simulation(scene);
+        for (int step = 0; step < 60; ++step) stepper.run(app, 1);
+        CHECK(position_hash(app) == r.app);
+        CHECK(app.settings().integration.substeps == r.app_substeps);
+    }
+    for (const RecordedVariant& v : kRecordedVariants) {
+        INFO("drape-sphere, " << v.set);
+        Scene scene = load_scene("drape-sphere");
+        apply_override(scene, v.set);
+        MassSpring sim = build_simulation(scene);
+        sim.run_steps(10);
+        CHECK(position_hash(sim) == v.plain);
+    }
+}
+
+TEST_CASE("stepper advance runs whole steps of dt and carries the remainder", "[stepper]") {
+    MassSpring sim = hanging(0.01f);
+    Stepper stepper;
+    CHECK(stepper.advance(sim, 0.025).steps == 2);  // 5 ms carried
+    CHECK(stepper.advance(sim, 0.004).steps == 0);  // 9 ms
+    CHECK(stepper.advance(sim, 0.002).steps == 1);  // 11 ms: one step, 1 ms left
+    CHECK(sim.time() == Approx(0.03).margin(1e-5));
+    stepper.restart();
+    CHECK(stepper.advance(sim, 0.0095).steps == 0);  // the 1 ms was forgotten
+}
+
+TEST_CASE("stepper advance caps the catch-up and says how much time it dropped", "[stepper]") {
+    MassSpring sim = hanging(0.01f);
+    RunPolicy policy;
+    policy.max_catchup_steps = 4;
+    Stepper stepper(policy);
+    const StepReport report = stepper.advance(sim, 0.105);  // 10 steps owed
+    CHECK(report.steps == 4);
+    CHECK(report.dropped_seconds == Approx(0.06).margin(1e-9));
+    CHECK(sim.time() == Approx(0.04).margin(1e-5));
+    CHECK(stepper.advance(sim, 0.0).steps == 0);  // nothing carried past a capped frame
+}
+
+TEST_CASE("stepper auto substeps follows a stiffness change and keeps the substep at the safety fraction",
+          "[stepper]") {
+    MassSpring sim = hanging(0.01f);
+    RunPolicy policy;
+    policy.auto_substeps = true;
+    policy.safety = 0.5f;
+    Stepper stepper(policy);
+    stepper.run(sim, 1);
+    const int soft = sim.settings().integration.substeps;
+    CHECK(sim.substep_length() <= 0.5 * stepper.limit(sim).critical_substep * (1.0 + 1e-6));
+
+    test::edit_settings(sim, [](SimulationSettings& s) { s.springs.structural *= 16.0f; });
+    stepper.run(sim, 1);
+    const int stiff = sim.settings().integration.substeps;
+    CHECK(stiff > soft);
+    CHECK(sim.substep_length() <= 0.5 * stepper.limit(sim).critical_substep * (1.0 + 1e-6));
+    CHECK(sim.substep_length() > 0.25 * stepper.limit(sim).critical_substep);  // not far below it either
+
+    stepper.set_auto_substeps(false);
+    test::edit_settings(sim, [](SimulationSettings& s) { s.springs.structural /= 16.0f; });
+    stepper.run(sim, 1);
+    CHECK(sim.settings().integration.substeps == stiff);  // off: the substeps stay as they are
+}
+
+TEST_CASE("stepper the guard doubles the substeps of a step that blew up and turns auto substeps off",
+          "[stepper]") {
+    Scene scene = load_scene("hanging");
+    scene.settings.integration.substeps = 1;  // 16.7 ms against a critical substep near 0.6 ms: blows up
+    MassSpring sim = build_simulation(scene);
+    RunPolicy policy;
+    policy.guard = true;
+    Stepper stepper(policy);
+    const StepReport report = stepper.run(sim, 3);
+    CHECK(report.steps == 3);
+    CHECK_FALSE(report.guard_gave_up);
+    CHECK(sim.all_finite());
+    CHECK(sim.settings().integration.substeps > 8);
+    CHECK(report.guard_log.find("doubled integration.substeps from 1 to 2") != std::string::npos);
+
+    // With auto substeps on, the guard's choice stays: auto substeps turns itself off and says so.
+    MassSpring strict = build_simulation(load_scene("hanging"));
+    RunPolicy strict_policy;
+    strict_policy.auto_substeps = true;
+    strict_policy.guard = true;
+    strict_policy.guard_settings.max_strain = 1e-9f;  // any stretch counts as a blow-up
+    strict_policy.guard_settings.max_retries = 1;
+    Stepper strict_stepper(strict_policy);
+    const StepReport gave_up = strict_stepper.run(strict, 1);
+    CHECK(gave_up.guard_gave_up);
+    CHECK_FALSE(strict_stepper.policy().auto_substeps);
+    CHECK(gave_up.guard_log.find("auto substeps turned off") != std::string::npos);
+    CHECK(strict.all_finite());
+}
+
+TEST_CASE("stepper a non-finite cloth is not stepped", "[stepper]") {
+    MassSpring sim = hanging();
+    sim.set_particle(sim.particle_count() - 1, glm::vec3(NAN), glm::vec3(0.0f));
+    Stepper stepper;
+    const double time = sim.time();
+    const StepReport report = stepper.run(sim, 2);
+    CHECK(report.skipped_non_finite);
+    CHECK(report.steps == 0);
+    CHECK(sim.time() == time);
+}

@@ -30,6 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -122,6 +123,18 @@ public:
     // Moves a pinned particle to `position` (a grab, a moving anchor); it carries no velocity of its own, its
     // springs pull on its neighbours from the new place at the next step. Does nothing to a free particle.
     void move_pinned(std::size_t i, glm::vec3 position);
+    // A user's grab: free particle `i` is pulled toward `target` by a stiff, critically damped spring whose
+    // force is capped (grab_force_limit), the way cloth follows the mouse in Blender or Ten Minute Physics,
+    // instead of being teleported. Its stiffness is a quarter of m / h^2 (w h = 0.5 for the particle alone,
+    // inside every explicit integrator's limit), the cap stretches the particle's own springs by 50% at most
+    // (with a floor of 10 m |g|), so a hard drag pulls the cloth but cannot tear it into a spike. Calling it
+    // again moves the target; it wakes the cloth. A pinned particle is moved with move_pinned instead.
+    void grab(std::size_t i, glm::vec3 target);
+    void release_grab();
+    std::optional<std::size_t> grabbed() const { return grab_ ? std::optional<std::size_t>(grab_->particle) : std::nullopt; }
+    // N: the grab's force on the grabbed particle at the current state (0 without a grab), and its cap.
+    glm::vec3 grab_force() const;
+    float grab_force_limit() const { return grab_ ? grab_->force_limit : 0.0f; }
     // Moves a particle and gives it a velocity (for tests and tools); others keep theirs.
     void set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity);
 
@@ -140,6 +153,7 @@ private:
     void limit_strain();
     void limit_speed(float h);
     void check_sleep(float h);
+    glm::vec3 grab_force(const State& state) const;
 
     // The fast solver, deep-copied with the simulation (GridSolver is internal to src/core).
     struct FastSolver {
@@ -172,6 +186,13 @@ private:
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;
     std::uint64_t setup_stamp_ = 0;
+    struct Grab {
+        std::size_t particle = 0;
+        glm::vec3 target{0.0f};
+        float force_limit = 0.0f;  // N
+    };
+    std::optional<Grab> grab_;
+    Vec3Array grab_external_;    // N: the grab's force alone (zero but for the grabbed particle), for the fast solver
 };
 
 // The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it

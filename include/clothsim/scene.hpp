@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <span>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -68,6 +69,11 @@ Scene load_scene(std::string_view name_or_path);
 void apply_override(Scene& scene, std::string_view assignment);
 // Every field range, and the checks that span fields (axes, pins inside the grid, grid size).
 void validate(const Scene& scene);
+// The panel's way in, checked against the same table as the loader: clamps `field` of `scene` into its
+// allowed range (each component of a vector; a non-finite value goes to the nearest bound, NaN to the
+// minimum) and returns the note to show ("forces.wind = [0, 0, 1e+09] is out of range; allowed: ...; set to
+// [0.0, 0.0, 10000.0]"), or nothing when the value was allowed.
+std::optional<std::string> clamp_to_range(Scene& scene, const FieldInfo& field);
 // The whole scene as a TOML document that parse_scene() reads back to the same Scene.
 std::string to_toml(const Scene& scene);
 

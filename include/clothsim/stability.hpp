@@ -49,7 +49,9 @@ struct GuardSettings {
 // the retries ran out (the simulation is then left at the last good state, never NaN).
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log);
 
-// The largest |d| / L0 - 1 over springs with L0 > 0 (NaN-safe: a non-finite spring counts as infinite).
+// The largest |d| / L0 - 1 over springs with L0 > 0 (NaN-safe: a non-finite spring counts as infinite),
+// leaving out the springs of a grabbed particle (a strain the user imposes is not a blow-up) and springs of
+// a kind with stiffness 0 (they exert no force).
 double max_strain(const MassSpring& sim);
 
 }  // namespace clothsim

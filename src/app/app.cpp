@@ -50,7 +50,8 @@ std::filesystem::path texture_directory() {
 
 // The 3D view: the window right of the panel, in window coordinates (x, y from the top-left, w, h).
 glm::vec4 view_rect(const AppState& app, const Window& window, float scale) {
-    return clothsim::view_rect(glm::vec2(window.window_size()), panel_width(app, scale));
+    const glm::vec2 size(window.window_size());
+    return clothsim::view_rect(size, panel_width(app, scale, size.x));
 }
 
 float view_aspect(const AppState& app, const Window& window, float scale) {
@@ -81,6 +82,8 @@ void record_energy(AppState& app) {
 void after_rebuild(AppState& app, Renderer& renderer) {
     app.grab.reset();
     app.stepper.restart();
+    app.stats.dropped_seconds = 0.0;
+    app.failures_in_a_row = 0;
     app.stats.kinetic.clear();
     app.stats.potential.clear();
     app.stats.total.clear();
@@ -101,15 +104,27 @@ bool rebuild(AppState& app, Renderer& renderer, const Scene& scene) {
     return true;
 }
 
-// What the guard did this frame, told to the user; when it gave up, the app pauses at the last good state.
-void report_guard(AppState& app, const StepReport& report) {
-    if (report.guard_log.empty()) return;
+// What the guard did this frame, told to the user. When it gave up, the grab (the usual cause) is let go
+// and the app pauses at the last good state; when it gives up again before any step has succeeded, playing
+// on would only fail again, so the scene restarts (returns true: reset).
+bool report_guard(AppState& app, const StepReport& report) {
+    if (report.steps > 0 && !report.guard_gave_up) app.failures_in_a_row = 0;
+    if (report.guard_log.empty()) return false;
     app.say(report.guard_log, report.guard_gave_up);
-    if (report.guard_gave_up) {
-        app.paused = true;
-        app.say(report.guard_log + "paused at the last good state: lower integration.dt or soften the springs, then play",
-                true);
+    if (!report.guard_gave_up) return false;
+    app.sim.release_grab();
+    app.grab.reset();
+    if (++app.failures_in_a_row >= 2) {
+        app.failures_in_a_row = 0;
+        app.say(report.guard_log + "the step failed again from the same state: the scene restarts", true);
+        return true;
     }
+    app.paused = true;
+    app.say(report.guard_log +
+                "paused at the last good state; Play tries again from there (a second failure restarts the scene), "
+                "R restarts now",
+            true);
+    return false;
 }
 
 // The energy plots gain a point per frame that stepped; a cloth that rested through the frame repeats the
@@ -125,8 +140,9 @@ void record_plots(AppState& app, bool rested) {
 }
 
 // This frame's physics, through the stepper: one step per frame in scripted runs, one for Step, otherwise
-// the wall time that passed (scaled) in fixed steps of integration.dt.
-void simulate(AppState& app, double wall_seconds, bool scripted) {
+// the wall time that passed (scaled) in fixed steps of integration.dt. Returns true when the scene must
+// restart (the guard failed twice in a row).
+bool simulate(AppState& app, double wall_seconds, bool scripted) {
     const auto start = Clock::now();
     app.sim.reset_profile();
     const bool was_resting = app.sim.resting();
@@ -141,12 +157,13 @@ void simulate(AppState& app, double wall_seconds, bool scripted) {
         report = app.stepper.run(app.sim, 0);  // auto substeps still follows the panel's edits
     }
     app.step_once = false;
-    report_guard(app, report);
+    const bool restart = report_guard(app, report);
     if (report.steps > 0) record_plots(app, was_resting && app.sim.resting());
     app.stats.dropped_seconds += report.dropped_seconds;
     app.stats.profile = app.sim.profile();
     app.stats.sim_ms = std::chrono::duration<float, std::milli>(Clock::now() - start).count();
     app.stats.substeps_last_frame = report.steps * app.sim.settings().integration.substeps;
+    return restart;
 }
 
 Ray cursor_ray(const AppState& app, const Window& window, float scale) {
@@ -162,10 +179,20 @@ void pins_to_scene(AppState& app) {
     app.scene.pins.preset = PinPreset::None;
     app.scene.pins.particles.clear();
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {
-        if (app.sim.state().pinned[i] && !(app.grab && app.grab->particle == i && !app.grab->was_pinned)) {
+        if (app.sim.state().pinned[i]) {
             app.scene.pins.particles.emplace_back(static_cast<int>(i) / cols, static_cast<int>(i) % cols);
         }
     }
+}
+
+// Left-drag on the cloth grabs a particle: a free one is pulled by the simulation's force-limited grab
+// spring (MassSpring::grab), a pinned one is moved (the pin goes where the mouse takes it).
+void drag_grabbed(AppState& app, const Window& window, float scale) {
+    const Grab& grab = *app.grab;
+    const auto p = intersect_plane(cursor_ray(app, window, scale), grab.plane_point, grab.plane_normal);
+    if (!p) return;
+    if (grab.was_pinned) app.sim.move_pinned(grab.particle, *p);
+    else app.sim.grab(grab.particle, *p);
 }
 
 void handle_mouse(AppState& app, const Window& window, float scale) {
@@ -174,11 +201,9 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     const float height = static_cast<float>(window.window_size().y);
     if (app.grab) {
         if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
-            if (auto p = intersect_plane(cursor_ray(app, window, scale), app.grab->plane_point, app.grab->plane_normal)) {
-                app.sim.move_pinned(app.grab->particle, *p);
-            }
+            drag_grabbed(app, window, scale);
         } else {
-            if (!app.grab->was_pinned) app.sim.set_pinned(app.grab->particle, false);
+            app.sim.release_grab();
             app.grab.reset();
         }
         return;
@@ -194,7 +219,7 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
             app.say("particle " + std::to_string(*hit) + (pinned ? " pinned" : " unpinned"));
         } else if (hit) {
             app.grab = Grab{*hit, app.sim.particle(*hit).pinned, positions[*hit], -app.camera.forward()};
-            app.sim.set_pinned(*hit, true);
+            drag_grabbed(app, window, scale);
         }
     }
     if (app.grab) return;
@@ -251,6 +276,16 @@ bool save_scene(AppState& app, const std::string& path) {
     return true;
 }
 
+// Every label that names the scene follows the one loaded: the window title, the file fields' paths.
+void follow_scene(AppState& app, const Window& window) {
+    glfwSetWindowTitle(window.get(), ("clothsim - " + app.scene.name).c_str());
+    app.save_path = app.scene.name + "-edited.toml";
+    app.open_path = std::filesystem::absolute(app.scene_source.ends_with(".toml")
+                                                  ? std::filesystem::path(app.scene_source)
+                                                  : scene_directory() / (app.scene_source + ".toml"))
+                        .string();
+}
+
 void apply_requests(AppState& app, Renderer& renderer, const Window& window, float scale, PanelRequests& requests) {
     const float aspect = view_aspect(app, window, scale);
     if (requests.load) {
@@ -259,13 +294,17 @@ void apply_requests(AppState& app, Renderer& renderer, const Window& window, flo
             app.say(*error, true);
         } else {
             app.scene_source = *requests.load;
+            follow_scene(app, window);
             after_rebuild(app, renderer);
             reset_camera(app, aspect);
             app.say("loaded " + *requests.load);
         }
     }
-    if (requests.reset && rebuild(app, renderer, app.loaded)) app.say("reset to the start of " + app.scene.name);
-    if (requests.rebuild) rebuild(app, renderer, app.document());
+    if (requests.reset && rebuild(app, renderer, app.loaded)) {
+        app.stepper = Stepper(app.start_policy);  // R also restores auto substeps if the guard turned it off
+        app.say("reset to the start of " + app.scene.name);
+    }
+    if (requests.rebuild) rebuild(app, renderer, *requests.rebuild);
     if (requests.save) save_scene(app, *requests.save);
     if (requests.frame_camera) frame_camera(app, aspect);
     if (requests.reset_camera) reset_camera(app, aspect);
@@ -288,8 +327,11 @@ bool apply_view_option(ViewSettings& view, bool& show_panel, const std::string& 
 
 std::string timestamped_screenshot_name() {
     const std::time_t now = std::time(nullptr);
-    char name[64];
-    std::strftime(name, sizeof name, "clothsim-%Y%m%d-%H%M%S.png", std::localtime(&now));
+    char stamp[64];
+    std::strftime(stamp, sizeof stamp, "clothsim-%Y%m%d-%H%M%S", std::localtime(&now));
+    // Two screenshots within a second get -2, -3, ...: a name never overwrites an earlier file.
+    std::string name = std::string(stamp) + ".png";
+    for (int n = 2; std::filesystem::exists(name); ++n) name = std::string(stamp) + "-" + std::to_string(n) + ".png";
     return name;
 }
 
@@ -335,15 +377,10 @@ void stop_imgui() {
 
 // The panel's start values: the view options, and the file fields filled with the scene's path and an
 // "-edited" name to save to.
-void start_panel(AppState& app, const Scene& scene, const AppOptions& options) {
+void start_panel(AppState& app, const AppOptions& options) {
     app.paused = options.start_paused;
     app.view = options.view;
     app.show_panel = options.show_panel;
-    app.save_path = scene.name + "-edited.toml";
-    app.open_path = std::filesystem::absolute(options.scene_source.ends_with(".toml")
-                                                  ? std::filesystem::path(options.scene_source)
-                                                  : scene_directory() / (options.scene_source + ".toml"))
-                        .string();
 }
 
 // The 3D view's viewport in framebuffer pixels (x, y from the bottom-left, width, height).
@@ -373,7 +410,7 @@ PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window
 
 // The panel's requests join the keys' (a key and a button may ask for the same thing).
 void merge_requests(PanelRequests& into, const PanelRequests& panel) {
-    into.rebuild |= panel.rebuild;
+    if (panel.rebuild) into.rebuild = panel.rebuild;
     into.reset |= panel.reset;
     into.frame_camera |= panel.frame_camera;
     into.reset_camera |= panel.reset_camera;
@@ -423,7 +460,7 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         handle_keys(app, keys, requests);
         handle_mouse(app, window, scale);
         const auto now = Clock::now();
-        simulate(app, std::chrono::duration<double>(now - last).count(), scripted);
+        requests.reset |= simulate(app, std::chrono::duration<double>(now - last).count(), scripted);
         last = now;
         merge_requests(requests, draw_frame(app, renderer, window, scale));
         ++frame;
@@ -492,7 +529,8 @@ int run_app(const Scene& scene, const AppOptions& options) {
     policy.safety = options.safety;
     policy.guard = true;
     AppState app(scene, options.scene_source, policy);
-    start_panel(app, scene, options);
+    start_panel(app, options);
+    follow_scene(app, *window);
     renderer->set_cloth(app.sim);
     const float scale = window->content_scale();
     reset_camera(app, view_aspect(app, *window, scale));

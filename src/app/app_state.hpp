@@ -12,6 +12,9 @@
 #include "clothsim/stepper.hpp"
 
 #include <array>
+#include <chrono>
+#include <deque>
+#include <iostream>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -62,7 +65,39 @@ struct Stats {
     bool cloth_uploaded = false;  // the renderer uploaded positions and normals this frame
 };
 
-// A particle held with the mouse: pinned while held and moved in the plane facing the camera.
+// The panel's message area: the latest messages, newest last. Notes expire after 8 s, errors after 30 s,
+// and at most 20 are kept, so the area never grows; the panel shows it at a fixed height.
+struct Messages {
+    using Clock = std::chrono::steady_clock;
+    struct Message {
+        std::string text;
+        bool error = false;
+        Clock::time_point expires;
+    };
+    static constexpr std::size_t kMax = 20;
+    std::deque<Message> list;
+
+    // Returns false when it repeats the newest message (which then only lives longer).
+    bool add(std::string text, bool error) {
+        while (!text.empty() && text.back() == '\n') text.pop_back();
+        const auto expires = Clock::now() + std::chrono::seconds(error ? 30 : 8);
+        if (!list.empty() && list.back().text == text && list.back().error == error) {
+            list.back().expires = expires;  // said again (a widget still being typed into): one line
+            return false;
+        }
+        list.push_back({std::move(text), error, expires});
+        while (list.size() > kMax) list.pop_front();
+        return true;
+    }
+    void expire() {
+        const auto now = Clock::now();
+        std::erase_if(list, [&](const Message& m) { return m.expires <= now; });
+    }
+    void clear() { list.clear(); }
+};
+
+// A particle held with the mouse, moved in the plane facing the camera: a free one through the grab spring
+// (MassSpring::grab), a pinned one by moving the pin.
 struct Grab {
     std::size_t particle = 0;
     bool was_pinned = false;
@@ -78,6 +113,8 @@ struct AppState {
     std::string scene_source; // bundled name or path it came from
     MassSpring sim;           // the running cloth; owns the live settings (MassSpring::apply)
     Stepper stepper;          // the run policy: fixed step, catch-up cap, auto substeps, the guard
+    RunPolicy start_policy;   // ... as the app started with it: what R restores
+    int failures_in_a_row = 0;  // guard failures with no good step between them
     OrbitCamera camera;
     ViewSettings view;
     bool paused = false;
@@ -87,26 +124,27 @@ struct AppState {
     bool vsync = true;
     Stats stats;
     std::optional<Grab> grab;
-    std::string status;        // the last message for the user (errors, screenshot path)
-    bool status_is_error = false;
+    Messages messages;         // what the app tells the user (errors, notes, screenshot paths)
     std::string open_path;     // the panel's "Open scene file" text
     std::string save_path;     // the panel's "Save scene as" text
 
     AppState(const Scene& s, std::string source, const RunPolicy& policy)
-        : scene(s), loaded(s), scene_source(std::move(source)), sim(build_simulation(s)), stepper(policy) {}
+        : scene(s), loaded(s), scene_source(std::move(source)), sim(build_simulation(s)), stepper(policy), start_policy(policy) {}
 
     // The scene as it runs: the document with the simulation's live settings (what Save writes).
     Scene document() const { return running_scene(scene, sim); }
 
+    // A message in the panel's message area; an error also goes to stderr.
     void say(std::string message, bool error = false) {
-        status = std::move(message);
-        status_is_error = error;
+        if (messages.add(message, error) && error) {
+            std::cerr << "clothsim: " << message << (message.ends_with('\n') ? "" : "\n");
+        }
     }
 };
 
 // What the panel asks the app to do after this frame.
 struct PanelRequests {
-    bool rebuild = false;       // cloth or pins changed
+    std::optional<Scene> rebuild;  // cloth or pins changed: rebuild from this edited scene
     bool reset = false;         // back to the loaded scene's start
     bool frame_camera = false;
     bool reset_camera = false;
@@ -120,6 +158,6 @@ struct PanelRequests {
 PanelRequests draw_panel(AppState& app, float content_scale);
 
 // Width of the panel in window coordinates (0 when hidden): the 3D view takes the rest of the window.
-float panel_width(const AppState& app, float content_scale);
+float panel_width(const AppState& app, float content_scale, float window_width);
 
 }  // namespace clothsim

@@ -10,6 +10,7 @@
 namespace clothsim {
 
 inline constexpr float kPanelWidth = 360.0f;  // window coordinates at content scale 1
+inline constexpr float kMaxPanelShare = 0.45f;  // of the window's width: a narrow window keeps a 3D view
 
 // The 3D view (x, y from the top-left, width, height) in window coordinates.
 inline glm::vec4 view_rect(glm::vec2 window_size, float panel_width) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <type_traits>
 #include <variant>
 
@@ -91,16 +92,14 @@ std::string label_of(const FieldInfo& f) {
 }
 
 // A float field: a slider over the hinted extent (logarithmic where the range spans decades), else a drag.
+// A typed value (ctrl+click) is not clamped here: keep_in_range clamps it to the field's range with a note.
 bool float_widget(const std::string& label, const FieldInfo& f, float* v) {
     if (const SliderHint* h = hint_for(f.name)) {
-        const bool edited = ImGui::SliderFloat(label.c_str(), v, h->lo, h->hi, "%.4g",
-                                               h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
-        *v = std::clamp(*v, static_cast<float>(f.min), static_cast<float>(f.max));
-        return edited;
+        return ImGui::SliderFloat(label.c_str(), v, h->lo, h->hi, "%.4g",
+                                  h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
     }
     const float speed = std::max(std::fabs(*v) * 0.01f, 0.001f);
-    return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max), "%.4g",
-                            ImGuiSliderFlags_AlwaysClamp);
+    return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max), "%.4g");
 }
 
 // The pins: a preset picked in a combo (which drops the particles pinned by hand).
@@ -129,19 +128,18 @@ bool value_widget(Scene& edit, const FieldInfo& f) {
     return std::visit(
         Overloaded{
             [&](int* v) {
-                return ImGui::DragInt(label.c_str(), v, 0.2f, static_cast<int>(f.min), static_cast<int>(f.max), "%d",
-                                      ImGuiSliderFlags_AlwaysClamp);
+                return ImGui::DragInt(label.c_str(), v, 0.2f, static_cast<int>(f.min), static_cast<int>(f.max), "%d");
             },
             [&](float* v) { return float_widget(label, f, v); },
             [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
             [&](glm::vec2* v) {
                 return ImGui::DragFloat2(label.c_str(), &v->x, 0.01f, static_cast<float>(f.min),
-                                         static_cast<float>(f.max), "%.3g", ImGuiSliderFlags_AlwaysClamp);
+                                         static_cast<float>(f.max), "%.3g");
             },
             [&](glm::vec3* v) {
                 const float speed = std::max(0.005f, 0.01f * std::max({std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)}));
                 return ImGui::DragFloat3(label.c_str(), &v->x, speed, static_cast<float>(f.min),
-                                         static_cast<float>(f.max), "%.3g", ImGuiSliderFlags_AlwaysClamp);
+                                         static_cast<float>(f.max), "%.3g");
             },
             [&](std::string* v) {
                 char buffer[256];
@@ -195,15 +193,23 @@ bool field_widget(Scene& edit, const Scene& loaded, const FieldInfo& f) {
     return changed;
 }
 
+// Clamps a field the user just edited into its allowed range (the loader's table), with a note when it did.
+void keep_in_range(AppState& app, Scene& edit, const FieldInfo& f) {
+    if (auto note = clamp_to_range(edit, f)) app.say(*note, true);
+}
+
 // Draws every field of `edit` whose name starts with `prefix`; returns true when any changed.
-bool fields_section(Scene& edit, const AppState& app, std::string_view prefix) {
+bool fields_section(Scene& edit, AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
         if (!f.name.starts_with(prefix)) continue;
         // Auto substeps owns the substeps field; greyed out so an edit is not silently overwritten.
         const bool owned = app.stepper.policy().auto_substeps && f.name == "integration.substeps";
         if (owned) ImGui::BeginDisabled();
-        changed |= field_widget(edit, app.loaded, f);
+        if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
+            keep_in_range(app, edit, f);
+            changed = true;
+        }
         if (owned) ImGui::EndDisabled();
     }
     return changed;
@@ -294,30 +300,44 @@ void help_section() {
 
 }  // namespace
 
-float panel_width(const AppState& app, float content_scale) {
-    return app.show_panel ? kPanelWidth * content_scale : 0.0f;
+float panel_width(const AppState& app, float content_scale, float window_width) {
+    if (!app.show_panel) return 0.0f;
+    return std::min(kPanelWidth * content_scale, kMaxPanelShare * window_width);
 }
 
 namespace {
 
-void status_line(const AppState& app) {
-    if (app.status.empty()) return;
+// The message area: a fixed height at the bottom of the panel (it never pushes the widgets), newest last,
+// scrolled to the newest, with a button to clear it.
+void message_area(AppState& app, float height) {
+    app.messages.expire();
+    ImGui::BeginChild("messages", ImVec2(0.0f, height), true);
+    if (app.messages.list.empty()) ImGui::TextDisabled("no messages");
     ImGui::PushTextWrapPos(0.0f);
-    ImGui::TextColored(app.status_is_error ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
-                       app.status.c_str());
+    for (const Messages::Message& m : app.messages.list) {
+        ImGui::TextColored(m.error ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
+                           m.text.c_str());
+    }
     ImGui::PopTextWrapPos();
-    ImGui::Separator();
+    if (ImGui::GetScrollY() >= ImGui::GetScrollMaxY()) ImGui::SetScrollHereY(1.0f);
+    ImGui::EndChild();
+    if (ImGui::SmallButton("Clear messages")) app.messages.clear();
 }
 
 // Bundled scenes, open a file, play / step / reset, time scale, save.
 void scene_section(AppState& app, PanelRequests& requests) {
     const std::vector<std::string> names = bundled_scene_names();
-    if (ImGui::BeginCombo("bundled", app.scene_source.c_str())) {
+    // The combo names the scene that runs: a bundled one by name, a file by its file name (full path in the
+    // tooltip and in the file field below).
+    const bool from_file = app.scene_source.ends_with(".toml");
+    const std::string shown = from_file ? std::filesystem::path(app.scene_source).filename().string() : app.scene_source;
+    if (ImGui::BeginCombo("bundled", shown.c_str())) {
         for (const std::string& n : names) {
             if (ImGui::Selectable(n.c_str(), n == app.scene_source)) requests.load = n;
         }
         ImGui::EndCombo();
     }
+    if (from_file && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", app.scene_source.c_str());
     char open[512];
     std::snprintf(open, sizeof open, "%s", app.open_path.c_str());
     if (ImGui::InputText("##open", open, sizeof open)) app.open_path = open;
@@ -332,7 +352,8 @@ void scene_section(AppState& app, PanelRequests& requests) {
     }
     ImGui::SameLine();
     if (ImGui::Button("Reset (R)")) requests.reset = true;
-    ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic);
+    ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx",
+                       ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
     char save[512];
     std::snprintf(save, sizeof save, "%s", app.save_path.c_str());
@@ -343,13 +364,14 @@ void scene_section(AppState& app, PanelRequests& requests) {
 }
 
 // The forces' fields, and the wind as strength and heading, as a user thinks of it (both edit forces.wind).
-void forces_section(Scene& edit, const AppState& app) {
+void forces_section(Scene& edit, AppState& app) {
     fields_section(edit, app, "forces.");
     glm::vec3& wind = edit.settings.forces.wind;
     float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
     const float old_speed = speed;
     if (ImGui::SliderFloat("wind speed", &speed, 0.0f, 50.0f, "%.2f m/s")) {
         wind = old_speed > 0.0f ? wind * (speed / old_speed) : glm::vec3(speed, 0.0f, 0.0f);
+        keep_in_range(app, edit, *find_field("forces.wind"));  // a typed speed obeys forces.wind's range
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("|forces.wind| in m/s; keeps the direction");
     float heading = std::atan2(wind.z, wind.x) * 57.29578f;
@@ -357,6 +379,7 @@ void forces_section(Scene& edit, const AppState& app) {
         const float horizontal = std::sqrt(wind.x * wind.x + wind.z * wind.z);
         wind.x = horizontal * std::cos(heading / 57.29578f);
         wind.z = horizontal * std::sin(heading / 57.29578f);
+        keep_in_range(app, edit, *find_field("forces.wind"));
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
 }
@@ -373,7 +396,7 @@ void stability_lines(AppState& app) {
         ImGui::SameLine();
         ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
         float safety = app.stepper.policy().safety;
-        if (ImGui::SliderFloat("safety", &safety, 0.05f, 1.0f, "%.2f")) app.stepper.set_safety(safety);
+        if (ImGui::SliderFloat("safety", &safety, 0.05f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) app.stepper.set_safety(safety);
     }
     const StabilityLimit& limit = app.stepper.limit(app.sim);
     const IntegrationSettings& integration = app.sim.settings().integration;
@@ -398,11 +421,11 @@ void integration_section(Scene& edit, AppState& app) {
     fields_section(edit, app, "integration.");
     fields_section(edit, app, "solver.");
     int catchup = app.stepper.policy().max_catchup_steps;
-    if (ImGui::SliderInt("max catch-up steps", &catchup, 1, 16)) app.stepper.set_max_catchup_steps(catchup);
+    if (ImGui::SliderInt("max catch-up steps", &catchup, 1, 16, "%d", ImGuiSliderFlags_AlwaysClamp)) app.stepper.set_max_catchup_steps(catchup);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
 }
 
-void colliders_section(Scene& edit, const AppState& app) {
+void colliders_section(Scene& edit, AppState& app) {
     ImGui::TextDisabled("sphere");
     fields_section(edit, app, "colliders.sphere.");
     ImGui::Separator();
@@ -427,7 +450,8 @@ void view_section(AppState& app, PanelRequests& requests) {
         ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.9f, 1.0f), "bending");
     }
     if (app.view.springs == SpringView::ByStrain) {
-        ImGui::SliderFloat("strain range", &app.view.strain_range, 0.001f, 0.5f, "%.3f", ImGuiSliderFlags_Logarithmic);
+        ImGui::SliderFloat("strain range", &app.view.strain_range, 0.001f, 0.5f, "%.3f",
+                       ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
         ImGui::TextDisabled("blue compressed, white at rest, red stretched");
     }
     ImGui::Checkbox("particles", &app.view.particles);
@@ -497,31 +521,39 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     PanelRequests requests;
     const ImGuiViewport* viewport = ImGui::GetMainViewport();
     ImGui::SetNextWindowPos(viewport->WorkPos, ImGuiCond_Always);
-    ImGui::SetNextWindowSize(ImVec2(panel_width(app, content_scale), viewport->WorkSize.y), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(panel_width(app, content_scale, viewport->WorkSize.x), viewport->WorkSize.y),
+                             ImGuiCond_Always);
     ImGui::SetNextWindowBgAlpha(0.92f);
     ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    // The settings scroll; the message area below them keeps its height, so nothing moves under the mouse.
+    const float message_height = 5.5f * ImGui::GetTextLineHeightWithSpacing();
+    ImGui::BeginChild("settings", ImVec2(0.0f, -(message_height + ImGui::GetFrameHeightWithSpacing() +
+                                                ImGui::GetStyle().ItemSpacing.y)));
     ImGui::PushItemWidth(-ImGui::GetFontSize() * 8.5f);
-    status_line(app);
-    // The widgets edit a copy of the running scene; a settings change reaches the simulation through its
-    // one call (MassSpring::apply), a cloth or pin change rebuilds the cloth after this frame.
+    // The widgets edit a copy of the running scene. A settings change reaches the simulation through its one
+    // call (MassSpring::apply); a cloth or pin change asks for a rebuild from the edited copy, which becomes
+    // the document only when it builds.
     Scene edit = app.document();
     if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) scene_section(app, requests);
+    bool cloth_changed = false;
     if (ImGui::CollapsingHeader("Cloth")) {
         ImGui::TextDisabled("changes rebuild the cloth");
-        requests.rebuild |= fields_section(edit, app, "cloth.");
-        requests.rebuild |= fields_section(edit, app, "pins");
+        cloth_changed |= fields_section(edit, app, "cloth.");
+        cloth_changed |= fields_section(edit, app, "pins");
     }
     if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(edit, app, "springs.");
     if (ImGui::CollapsingHeader("Forces")) forces_section(edit, app);
     if (ImGui::CollapsingHeader("Integration", ImGuiTreeNodeFlags_DefaultOpen)) integration_section(edit, app);
     if (ImGui::CollapsingHeader("Colliders")) colliders_section(edit, app);
     app.sim.apply(edit.settings);
-    app.scene = edit;
+    if (cloth_changed) requests.rebuild = edit;
     if (ImGui::CollapsingHeader("View")) view_section(app, requests);
     if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_section(app);
     if (ImGui::CollapsingHeader("Profile", ImGuiTreeNodeFlags_DefaultOpen)) profile_section(app);
     if (ImGui::CollapsingHeader("Help")) help_section();
     ImGui::PopItemWidth();
+    ImGui::EndChild();
+    message_area(app, message_height);
     ImGui::End();
     return requests;
 }

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
 
 namespace clothsim {
 namespace {
@@ -62,9 +64,88 @@ Contact<T> contact(const GroundCollider& ground, glm::vec<3, T> p, T thickness) 
     return {glm::vec<3, T>(T(0), T(1), T(0)), T(ground.height) + thickness - p.y};
 }
 
+// Continuous collision: where the straight path p0 -> p1 of a substep passed through the solid shape
+// (the sphere of radius r, the box itself, not the thickness shell around them) although both ends are
+// outside. A path that only grazes the shell (a particle sliding over the surface cuts a chord into it) is
+// not a pass. `t` is where the path enters the shell (radius r + thickness, the box grown by thickness) and
+// `normal` the shell's outward normal there.
+template <class T>
+struct SweptHit {
+    T t = T(0);
+    glm::vec<3, T> normal{T(0), T(1), T(0)};
+};
+
+// Smallest t in [0, 1] with |p0 + t d - c| = radius, if the segment reaches that sphere.
+template <class T>
+std::optional<T> enter_sphere(glm::vec<3, T> f, glm::vec<3, T> d, T radius) {
+    const T a = glm::dot(d, d);
+    if (!(a > T(0))) return std::nullopt;
+    const T b = glm::dot(f, d);
+    const T disc = b * b - a * (glm::dot(f, f) - radius * radius);
+    if (!(disc >= T(0))) return std::nullopt;
+    const T t = (-b - std::sqrt(disc)) / a;
+    if (!(t <= T(1)) || (-b + std::sqrt(disc)) / a < T(0)) return std::nullopt;
+    return std::max(t, T(0));
+}
+
+template <class T>
+std::optional<SweptHit<T>> swept_hit(const SphereCollider& sphere, glm::vec<3, T> p0, glm::vec<3, T> p1, T thickness) {
+    const glm::vec<3, T> f = p0 - glm::vec<3, T>(sphere.center), d = p1 - p0;
+    if (!enter_sphere(f, d, T(sphere.radius))) return std::nullopt;
+    SweptHit<T> hit;
+    hit.t = enter_sphere(f, d, T(sphere.radius) + thickness).value_or(T(0));
+    const glm::vec<3, T> at = f + hit.t * d;
+    const T length = glm::length(at);
+    if (length > T(1e-12f)) hit.normal = at / length;
+    return hit;
+}
+
+// Slab test against the box grown by `grow`: the entry t and the axis it enters through.
+template <class T>
+std::optional<std::pair<T, int>> enter_box(const CubeCollider& cube, glm::vec<3, T> p0, glm::vec<3, T> d, T grow) {
+    T near = T(0), far = T(1);
+    int axis = -1;
+    for (int a = 0; a < 3; ++a) {
+        const T lo = T(cube.center[a]) - T(0.5) * T(cube.size[a]) - grow;
+        const T hi = T(cube.center[a]) + T(0.5) * T(cube.size[a]) + grow;
+        if (d[a] == T(0)) {
+            if (p0[a] < lo || p0[a] > hi) return std::nullopt;
+            continue;
+        }
+        T t0 = (lo - p0[a]) / d[a], t1 = (hi - p0[a]) / d[a];
+        if (t0 > t1) std::swap(t0, t1);
+        if (t0 > near) {
+            near = t0;
+            axis = a;
+        }
+        far = std::min(far, t1);
+        if (!(near <= far)) return std::nullopt;
+    }
+    return std::pair<T, int>(near, axis);
+}
+
+template <class T>
+std::optional<SweptHit<T>> swept_hit(const CubeCollider& cube, glm::vec<3, T> p0, glm::vec<3, T> p1, T thickness) {
+    const glm::vec<3, T> d = p1 - p0;
+    if (!enter_box(cube, p0, d, T(0))) return std::nullopt;
+    const auto entry = enter_box(cube, p0, d, thickness);
+    SweptHit<T> hit;
+    if (!entry || entry->second < 0) return std::nullopt;  // started inside the shell: the depth test's case
+    hit.t = entry->first;
+    hit.normal = glm::vec<3, T>(T(0));
+    hit.normal[entry->second] = d[entry->second] > T(0) ? T(-1) : T(1);
+    return hit;
+}
+
+// The ground is a half-space: a path that ends below it ends in contact, so there is nothing to sweep.
+template <class T>
+std::optional<SweptHit<T>> swept_hit(const GroundCollider&, glm::vec<3, T>, glm::vec<3, T>, T) {
+    return std::nullopt;
+}
+
 // Returns a bound on how far it moved any particle: each push is at most depth (1 + friction) long (the normal
-// push plus a friction cut of at most friction x depth). A NaN position has NaN depth and is left alone (the
-// guard reports it).
+// push plus a friction cut of at most friction x depth), or the way back to where a swept path entered. A NaN
+// position has NaN depth and is left alone (the guard reports it).
 template <class T, class Shape>
 T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
                 std::size_t end) {
@@ -73,9 +154,26 @@ T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thicknes
     for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
         const Contact<T> c = contact(shape, state.position.get(i), thickness);
-        if (!(c.depth > T(0))) continue;
-        deepest = std::max(deepest, c.depth);
         const Vec motion = state.motion.get(i);
+        // A large step can end outside after passing through (no contact at the end), or inside past the
+        // middle, where the nearest way out points along the motion and leads out of the far side. Then the
+        // particle stops where its path (x - motion -> x: the motion is the substep's displacement for every
+        // integrator) entered the shell, the inward part of its motion removed as in any inelastic contact;
+        // no friction on this rare path.
+        if (!(c.depth > T(0)) || glm::dot(c.normal, motion) > T(0)) {
+            const Vec p1 = state.position.get(i), p0 = p1 - motion;
+            const auto hit = contact(shape, p0, thickness).depth > T(0) ? std::nullopt
+                                                                          : swept_hit(shape, p0, p1, thickness);
+            if (hit) {
+                const Vec entry = p0 + hit->t * motion;
+                deepest = std::max(deepest, glm::length(p1 - entry));
+                state.position.set(i, entry);
+                state.motion.set(i, motion - std::min(glm::dot(motion, hit->normal), T(0)) * hit->normal);
+                continue;
+            }
+            if (!(c.depth > T(0))) continue;
+        }
+        deepest = std::max(deepest, c.depth);
         const T normal_motion = glm::dot(motion, c.normal);
         const Vec tangential = motion - normal_motion * c.normal;
         // Coulomb: the tangential motion loses at most mu times the normal push (static when it is less).
@@ -87,7 +185,7 @@ T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thicknes
         // velocity of depth / h: a cloth started half inside the sphere exploded that way.
         state.motion.set(i, tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal);
     }
-    return deepest * (T(1) + friction);
+    return std::max(deepest * (T(1) + friction), deepest);
 }
 
 template <class Shape>
@@ -154,10 +252,17 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.current = blocks.boxes_current = false;
     } else if (!(blocks.current && blocks.boxes.size() == count)) {
         StageTimer timer(profile, Stage::BroadPhase);
-        if (!(blocks.boxes_current && blocks.boxes.size() == count)) {
-            blocks.boxes.resize(count);
-            for (std::size_t k = 0; k < count; ++k) {
-                blocks.boxes[k] = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
+        const bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
+        blocks.boxes.resize(count);
+        for (std::size_t k = 0; k < count; ++k) {
+            Box& box = blocks.boxes[k];
+            if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
+            // Swept boxes: they also hold where the substep started (x - motion), so a particle that passed
+            // through a collider in one substep is still offered to it (continuous collision).
+            const Box motion = particle_bounds(state.motion, blocks.start[k], blocks.start[k + 1]);
+            if (!motion.empty()) {
+                box.lo = glm::min(box.lo, box.lo - motion.hi);
+                box.hi = glm::max(box.hi, box.hi - motion.lo);
             }
         }
         blocks.cloth = Box{};

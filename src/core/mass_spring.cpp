@@ -151,7 +151,11 @@ void MassSpring::step_fast_sweep(float h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Wind);
         force_.resize(state_.size());
         accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
+        if (grab_) force_.add(grab_->particle, grab_force(state_));
         external = &force_;
+    } else if (grab_) {
+        grab_external_.set(grab_->particle, grab_force(state_));
+        external = &grab_external_;
     }
     const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
     {
@@ -172,6 +176,7 @@ void MassSpring::step_textbook(float h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Wind);
         add_wind_forces(state_, force_, wind_);
     }
+    if (grab_) force_.add(grab_->particle, grab_force(state_));
     {
         StageTimer timer(profile, Stage::Integrate);
         integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
@@ -275,6 +280,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, float h) {
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
         if (plan_.wind) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
+        if (grab_) f.add(grab_->particle, grab_force(s));
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
     switch (integrator) {
@@ -303,6 +309,47 @@ void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
         Vec3Array wind;
         add_wind_forces(state, force, wind);
     }
+    if (grab_) force.add(grab_->particle, grab_force(state));
+}
+
+void MassSpring::grab(std::size_t i, glm::vec3 target) {
+    if (state_.pinned.at(i)) return;
+    wake();
+    if (!grab_ || grab_->particle != i) {
+        // The cap: what stretches the particle's own springs by half their rest length, at least 10 m |g|.
+        float springs = 0.0f;
+        for (const Spring& s : topology_.springs) {
+            if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s.kind) * s.rest_length;
+        }
+        const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
+        grab_ = Grab{i, target, std::max(0.5f * springs, floor)};
+        grab_external_ = Vec3Array{};
+        grab_external_.resize(state_.size());
+    }
+    grab_->target = target;
+}
+
+void MassSpring::release_grab() {
+    if (!grab_) return;
+    grab_.reset();
+    grab_external_ = Vec3Array{};
+    wake();
+}
+
+glm::vec3 MassSpring::grab_force() const { return grab_ ? grab_force(state_) : glm::vec3(0.0f); }
+
+// F = k (target - x) - c v, k = m / (4 h^2), c = 2 sqrt(k m) (critical), |F| capped at force_limit.
+glm::vec3 MassSpring::grab_force(const State& state) const {
+    const std::size_t i = grab_->particle;
+    const float h = substep_length();
+    const float m = state.mass[i];
+    const float k = 0.25f * m / (h * h);
+    const float c = 2.0f * std::sqrt(k * m);
+    const glm::vec3 velocity = state.motion.get(i) / (state.substep > 0.0f ? state.substep : h);
+    glm::vec3 f = k * (grab_->target - state.position.get(i)) - c * velocity;
+    const float length = glm::length(f);
+    if (!(length <= grab_->force_limit)) f *= length > 0.0f ? grab_->force_limit / length : 0.0f;
+    return f;
 }
 
 void MassSpring::run_steps(long long steps) {
@@ -385,6 +432,7 @@ bool MassSpring::all_finite() const {
 }
 
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
+    if (pinned && grab_ && grab_->particle == i) release_grab();
     wake();
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();

@@ -229,4 +229,28 @@ void validate(const Scene& scene) {
     }
 }
 
+std::optional<std::string> clamp_to_range(Scene& scene, const FieldInfo& f) {
+    const std::string before = format_value(scene, f);
+    bool clamped = false;
+    // The bounds as the loader compares them (rounded to float for stored floats).
+    auto clamp = [&](auto& v) {
+        using T = std::remove_reference_t<decltype(v)>;
+        const T lo = static_cast<T>(f.min), hi = static_cast<T>(f.max);
+        if (v >= lo && v <= hi) return;  // false for NaN
+        v = v > hi ? hi : lo;
+        clamped = true;
+    };
+    std::visit(Overloaded{
+                   [&](int* v) { clamp(*v); },
+                   [&](float* v) { clamp(*v); },
+                   [&](glm::vec2* v) { clamp(v->x), clamp(v->y); },
+                   [&](glm::vec3* v) { clamp(v->x), clamp(v->y), clamp(v->z); },
+                   [&](auto*) {},
+               },
+               f.ref(scene));
+    if (!clamped) return std::nullopt;
+    return std::string(f.name) + " = " + before + " is out of range; allowed: " + describe_allowed(f) + "; set to " +
+           format_value(scene, f);
+}
+
 }  // namespace clothsim

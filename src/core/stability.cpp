@@ -114,8 +114,11 @@ int auto_substeps(const StabilityLimit& limit, float dt, float safety, int minim
 
 double max_strain(const MassSpring& sim) {
     double worst = 0.0;
+    const std::optional<std::size_t> grabbed = sim.grabbed();
     for (const Spring& s : sim.topology().springs) {
         if (s.rest_length == 0.0f) continue;
+        if (grabbed && (s.a == *grabbed || s.b == *grabbed)) continue;  // the user's pull, not a blow-up
+        if (stiffness_of(sim.settings().springs, s.kind) == 0.0f) continue;  // exerts no force: not a spring
         const double length = glm::length(glm::dvec3(sim.position(s.b)) - glm::dvec3(sim.position(s.a)));
         if (!std::isfinite(length)) return std::numeric_limits<double>::infinity();
         worst = std::max(worst, length / s.rest_length - 1.0);

@@ -10,11 +10,16 @@
 
 #include <catch2/catch.hpp>
 
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 using Catch::Contains;
 using namespace clothsim::test;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -120,7 +125,7 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
         const TempDir dir("session_open_combo");
         // flag (24 x 36), paused; the combo at the top of the panel, curtain its first item.
         const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
-                                             "click 110 59\nclick 40 84\nshot opened.png\nquit\n");
+                                             "click 110 59\nclick 40 84\nat 900 400\nsettle\nshot opened.png\nquit\n");
         CAPTURE_RUN(r);
         REQUIRE(r.code == 0);
         const Image opened = load_png(dir / "opened.png");
@@ -131,7 +136,7 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
         const TempDir dir("session_open_file");
         const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
                                              "click 115 82\nkey ctrl+a\ntype '" + scene_path("curtain") +
-                                                 "'\nclick 270 82\nshot opened.png\nquit\n");
+                                                 "'\nclick 270 82\nat 900 400\nsettle\nshot opened.png\nquit\n");
         CAPTURE_RUN(r);
         REQUIRE(r.code == 0);
         const Image opened = load_png(dir / "opened.png");
@@ -170,4 +175,55 @@ TEST_CASE("user session: a launch whose first step the guard rejects keeps drawi
         CAPTURE_RUN(r);
         CHECK(r.code == 0);
     }
+}
+
+TEST_CASE("user session: a hard, fast drag on curtain pulls the cloth without the guard stepping in") {
+    const clothsim::Scene scene = clothsim::load_scene("curtain");
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const glm::vec3 from = particle_on_screen(scene, middle);
+    const TempDir dir("session_hard_drag");
+    // 400 px in one jump of the mouse, held half a second, released, then the cloth plays on for 2 s.
+    const RunResult r = run_user_session(dir, {"--scene", "curtain"},
+                                         "drag " + at_xy(from) + " " + std::to_string(int(from.x) - 280) + " " +
+                                             std::to_string(int(from.y) - 280) + "\nsleep 2\nquit\n");
+    CAPTURE_RUN(r);
+    CHECK(r.code == 0);
+    CHECK_THAT(r.err, !Contains("guard"));  // the app's errors go to stderr too
+}
+
+TEST_CASE("user session: typed out-of-range values are clamped with a note, and Save writes a file Open accepts") {
+    const TempDir dir("session_typed");
+    // Forces open; wind speed typed 1e9 (allowed |wind| components up to 1e4), damping typed 1e9.
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
+                                         "click 50 335\n"
+                                         "ctrl_click 117 519\nkey ctrl+a\ntype 1e9\nkey Return\n"
+                                         "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
+                                         "click 285 151\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, Contains("forces.wind") && Contains("out of range") && Contains("springs.damping"));
+    const fs::path saved = dir / "flag-edited.toml";
+    REQUIRE(fs::exists(saved));
+    clothsim::Scene reopened;
+    REQUIRE_NOTHROW(reopened = clothsim::load_scene(saved.string()));
+    const clothsim::FieldInfo& wind = *clothsim::find_field("forces.wind");
+    CHECK(glm::length(reopened.settings.forces.wind) > 1000.0f);  // the typed value took effect, clamped
+    CHECK(std::abs(reopened.settings.forces.wind.x) <= wind.max);
+    CHECK(reopened.settings.springs.damping == static_cast<float>(clothsim::find_field("springs.damping")->max));
+}
+
+TEST_CASE("user session: labels follow the scene, and two F12 presses in a second write two files") {
+    const TempDir dir("session_labels");
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
+                                         "echo \"title before: $(xdotool getwindowname $wid)\"\n"
+                                         "click 110 59\nclick 40 84\nat 900 400\nsettle\n"
+                                         "echo \"title after: $(xdotool getwindowname $wid)\"\n"
+                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12; sleep 0.1\n"
+                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12\nsettle\nsettle\n"
+                                         "echo \"screenshots: $(ls clothsim-*.png | wc -l)\"\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("title before: clothsim - flag") && Contains("title after: clothsim - curtain"));
+    CHECK_THAT(r.out, Contains("screenshots: 2"));
 }

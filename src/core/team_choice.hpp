@@ -6,7 +6,7 @@
 // therefore keeps a running estimate of a substep's time with the team and with one thread, times one
 // substep the other way now and then (a probe), and uses whichever is faster. A probe that loses doubles the
 // wait before the next one (64 to 4096 substeps), so a team that stays slow costs little to keep checking.
-// Results are bit-identical for any thread count (grid_solver.hpp), so switching never changes the cloth.
+// Results are bit-identical for any thread count (fast_solver.hpp), so switching never changes the cloth.
 #pragma once
 
 #include <algorithm>

@@ -26,11 +26,11 @@
 
 namespace clothsim {
 
-class GridSolver {
+class FastSolver {
 public:
     // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions, each
     // direction either complete or absent (a cloth built without bending springs).
-    static std::optional<GridSolver> for_topology(const Topology& topology);
+    static std::optional<FastSolver> for_topology(const Topology& topology);
 
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
@@ -51,7 +51,7 @@ public:
     static bool force_generic_kernel(bool generic);
 
 private:
-    GridSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
+    FastSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
 
     struct Scratch {
         std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)

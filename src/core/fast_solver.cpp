@@ -1,4 +1,4 @@
-#include "grid_solver.hpp"
+#include "fast_solver.hpp"
 
 #include "clothsim/broad_phase.hpp"
 #include "verlet.hpp"
@@ -91,17 +91,17 @@ bool kAvx2 = cpu_has_avx2_fma();
 
 }  // namespace
 
-const char* GridSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
+const char* FastSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
 
-bool GridSolver::force_generic_kernel(bool generic) {
+bool FastSolver::force_generic_kernel(bool generic) {
     const bool was_avx2 = kAvx2;
     kAvx2 = !generic && cpu_has_avx2_fma();
     return !was_avx2;
 }
 
-std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
+std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     if (t.rows < 1 || t.cols < 1) return std::nullopt;
-    GridSolver solver(t.rows, t.cols);
+    FastSolver solver(t.rows, t.cols);
     const std::size_t n = static_cast<std::size_t>(t.rows) * t.cols;
     // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
     // exactly one spring for the sweep to be the same model as the spring list.
@@ -142,7 +142,7 @@ std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
     return solver;
 }
 
-int GridSolver::effective_threads(int requested) const {
+int FastSolver::effective_threads(int requested) const {
     // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, about 6 us,
     // and this runs every substep (it was half the CPU time of a small cloth's soak run).
     static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -150,7 +150,7 @@ int GridSolver::effective_threads(int requested) const {
     return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
 }
 
-void GridSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
+void FastSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
                       const Vec3Array* external, float h, std::vector<Box>* row_boxes) {
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
@@ -388,12 +388,12 @@ constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...
 
 }  // namespace
 
-void GridSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
+void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
     const Grid grid{rows_, cols_, rest_, present_};
     spring_row_table(kAvx2, std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
-void GridSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
+void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,

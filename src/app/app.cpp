@@ -13,6 +13,7 @@
 #include "window.hpp"
 
 #include "clothsim/atomic_file.hpp"
+#include "clothsim/data_dirs.hpp"
 #include "clothsim/scene.hpp"
 
 #include <GLFW/glfw3.h>
@@ -43,8 +44,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 std::filesystem::path texture_directory() {
-    if (const char* dir = std::getenv("CLOTHSIM_TEXTURES"); dir && *dir) return dir;
-    return CLOTHSIM_DEFAULT_TEXTURE_DIR;
+    return data_directory("CLOTHSIM_TEXTURES", CLOTHSIM_DEFAULT_TEXTURE_DIR);
 }
 
 // The 3D view: the window right of the panel, in window coordinates (x, y from the top-left, w, h).

@@ -4,6 +4,8 @@
 #include "app_state.hpp"
 #include "layout.hpp"
 
+#include "clothsim/overloaded.hpp"
+
 #include <imgui.h>
 
 #include <algorithm>
@@ -15,11 +17,6 @@
 
 namespace clothsim {
 namespace {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
 
 // Slider extents for fields whose valid range is too wide to drag through (the valid range still applies:
 // ctrl+click types any allowed value).

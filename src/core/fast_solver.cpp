@@ -81,22 +81,29 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, cons
     spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
+// Asked of the CPU once, on first use.
 bool cpu_has_avx2_fma() {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    static const bool has_avx2_fma = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    }();
+    return has_avx2_fma;
 }
 
-// Chosen once at start-up from the CPU; tests switch to the generic kernel to check it too.
-bool kAvx2 = cpu_has_avx2_fma();
+// Set by force_generic_kernel: the tests run the generic kernel on an AVX2 CPU to check it too.
+bool generic_kernel_forced = false;
+
+// Whether the AVX2 + FMA kernels run: the CPU has them and no test asked for the generic ones.
+bool use_avx2() { return cpu_has_avx2_fma() && !generic_kernel_forced; }
 
 }  // namespace
 
-const char* FastSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
+const char* FastSolver::kernel_name() { return use_avx2() ? "avx2+fma" : "generic"; }
 
 bool FastSolver::force_generic_kernel(bool generic) {
-    const bool was_avx2 = kAvx2;
-    kAvx2 = !generic && cpu_has_avx2_fma();
-    return !was_avx2;
+    const bool was_generic = !use_avx2();
+    generic_kernel_forced = generic;
+    return was_generic;
 }
 
 std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
@@ -390,7 +397,7 @@ constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...
 
 void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
     const Grid grid{rows_, cols_, rest_, present_};
-    spring_row_table(kAvx2, std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
+    spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
@@ -398,7 +405,7 @@ void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int 
     const Grid grid{rows_, cols_, rest_, present_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
-    sweep_table(kAvx2, std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
+    sweep_table(use_avx2(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }
 
 }  // namespace clothsim

@@ -100,7 +100,7 @@ void MassSpring::step() {
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
     blocks_.current = blocks_.boxes_current = false;  // positions move now: last substep's boxes are stale
     const Integrator integrator = settings_.integration.integrator;
-    if (h != state_.substep || static_cast<int>(integrator) != state_.integrator) restart(velocities(), h);
+    if (h != state_.substep || integrator != state_.integrator) restart(velocities(), h);
 
     switch (plan_.path) {
         case StepPath::Fast: step_fast(h, profile); break;
@@ -316,7 +316,7 @@ long long MassSpring::advance(double seconds) {
 
 void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
     const Integrator integrator = settings_.integration.integrator;
-    state_.integrator = static_cast<int>(integrator);
+    state_.integrator = integrator;
     if (integrator == Integrator::Verlet) {
         compute_forces(state_, force_);
         start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
@@ -342,7 +342,7 @@ std::vector<glm::vec3> MassSpring::positions() const {
 
 std::vector<glm::vec3> MassSpring::velocities() const {
     if (asleep_) return std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f));
-    if (state_.integrator != static_cast<int>(Integrator::Verlet)) {
+    if (state_.integrator != Integrator::Verlet) {
         std::vector<glm::vec3> v(state_.size(), glm::vec3(0.0f));
         if (state_.substep > 0.0f) {
             for (std::size_t i = 0; i < v.size(); ++i) v[i] = state_.motion.get(i) / state_.substep;

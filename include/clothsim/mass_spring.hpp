@@ -1,4 +1,5 @@
-// MassSpring: a cloth of particles joined by Hooke springs, advanced by position Verlet.
+// MassSpring: a cloth of particles joined by Hooke springs, advanced by one of five integrators (position
+// Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD: Integrator in settings.hpp).
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,

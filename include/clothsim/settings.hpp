@@ -35,7 +35,7 @@ enum class SolverMethod {
 // How wind acts on the cloth.
 enum class WindModel {
     Triangles,  // pressure on each triangle along its normal: an edge-on sheet feels none, a flag flutters
-    Uniform,    // the seed's isotropic drag toward the air velocity, the same for every particle
+    Uniform,    // isotropic drag toward the air velocity, the same for every particle
 };
 
 struct ClothSettings {

@@ -150,8 +150,8 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
 }
 
 int FastSolver::effective_threads(int requested) const {
-    // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, about 6 us,
-    // and this runs every substep (it was half the CPU time of a small cloth's soak run).
+    // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, and this
+    // runs every substep (docs/PERFORMANCE.md and docs/RELIABILITY.md have the cost).
     static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     const int wanted = requested > 0 ? requested : cores;
     return std::clamp(std::min(wanted, rows_ / 8), 1, 64);

@@ -7,8 +7,10 @@
 //    has it, chosen at run time; plain C++ otherwise) and each spring is computed once.
 //  - One pass over the rows does everything a substep needs. Row q's force is complete once the spring
 //    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
-//    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it (position
-//    Verlet) and collides it in place right then. Every particle's data is read and written once.
+//    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it in place
+//    (position Verlet) and, while the row is still in L1, writes the boxes of its particle blocks for the
+//    collision broad phase. Every particle's data is read and written once. Collisions are not part of the
+//    sweep: the caller's collision stage runs after it (collide_stage in colliders.hpp).
 //  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
 //    two spring rows just above it; they are computed before a barrier into shared storage and both
 //    neighbouring threads use the stored values. Each particle's force is summed in the same order for

@@ -1,5 +1,5 @@
 // The one place that says each scene field's unit, valid range and meaning. The loader, --set, validate(),
-// to_toml(), the README's field list and (later) the panel's tooltips all read this table.
+// to_toml(), the README's field list and the panel's tooltips all read this table.
 #include "clothsim/scene.hpp"
 
 #include "clothsim/overloaded.hpp"

@@ -1,4 +1,4 @@
-// The textbook cloth step as the seed and most tutorials write it: an array of particle structs, one loop
+// The textbook cloth step as most tutorials write it: an array of particle structs, one loop
 // over a spring list, one over the particles. Benchmark-only: it is the baseline the performance targets
 // were set against (../shared/PERFORMANCE_NOTES.md, "a textbook implementation ... 5.8 ns per spring-step").
 // The same model as MassSpring (Hooke springs, gravity, damped position Verlet, ground); the tests compare

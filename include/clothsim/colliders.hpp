@@ -44,7 +44,7 @@ struct CollisionBlocks {
     std::vector<std::size_t> start;  // block k is particles [start[k], start[k + 1])
     std::vector<Box> boxes;          // one per block
     Box cloth;                       // contains every block's box
-    bool boxes_current = false;      // the block boxes bound the particles as they are now (the sweep's)
+    bool boxes_current = false;      // the block boxes bound the particles as they are now (the fast solver's)
     bool current = false;            // ... and `cloth` bounds them
     std::size_t count() const { return start.empty() ? 0 : start.size() - 1; }
 };
@@ -52,8 +52,8 @@ struct CollisionBlocks {
 // The collision stage of a substep: the same contacts as collide_all, in the same order, but with
 // `broad_phase` a collider is skipped when it cannot touch the whole cloth's box, and is otherwise tested
 // particle by particle only on the blocks whose box may touch it (broad_phase.hpp). The boxes are computed
-// here unless the sweep left them (boxes_current), and a block's box is grown by the farthest push a collider
-// gave one of its particles, so the next collider's test stays conservative.
+// here unless the fast solver left them (boxes_current), and a block's box is grown by the farthest push a
+// collider gave one of its particles, so the next collider's test stays conservative.
 // Each collider's time and block counts go to `profile` when it is not null.
 void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile);

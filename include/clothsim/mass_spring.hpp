@@ -1,4 +1,5 @@
-// MassSpring: a cloth of particles joined by Hooke springs, advanced by position Verlet.
+// MassSpring: a cloth of particles joined by Hooke springs, advanced by one of five integrators (position
+// Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD: Integrator in settings.hpp).
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,
@@ -44,7 +45,7 @@ struct Energy {
     double total() const { return kinetic + potential(); }
 };
 
-class GridSolver;
+class FastSolver;
 
 class MassSpring {
 public:
@@ -88,9 +89,9 @@ public:
     Energy energy() const;
     glm::vec3 momentum() const;  // kg m/s, free particles
     bool all_finite() const;
-    // Whether settings().solver.method == Fast can run the fast grid solver (it needs a grid topology; it
+    // Whether settings().solver.method == Fast can run the fast solver (it needs a grid topology; it
     // runs position Verlet), and with how many threads the current settings step.
-    bool fast_solver_available() const { return grid_.solver != nullptr; }
+    bool fast_solver_available() const { return fast_.solver != nullptr; }
     int solver_threads() const;
     // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
     int last_solver_iterations() const { return last_iterations_; }
@@ -146,7 +147,7 @@ private:
     void add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const;
     void replan();
     // The stages of step(), in pipeline order.
-    void step_fast_sweep(float h, StepProfile* profile);
+    void step_fast(float h, StepProfile* profile);
     void step_textbook(float h, StepProfile* profile);
     void step_velocity_integrator(Integrator integrator, float h);
     void collide(StepProfile* profile);
@@ -155,22 +156,22 @@ private:
     void check_sleep(float h);
     glm::vec3 grab_force(const State& state) const;
 
-    // The fast solver, deep-copied with the simulation (GridSolver is internal to src/core).
-    struct FastSolver {
-        std::unique_ptr<GridSolver> solver;
-        FastSolver();
-        explicit FastSolver(std::unique_ptr<GridSolver> s);
-        FastSolver(const FastSolver& other);
-        FastSolver& operator=(const FastSolver& other);
-        FastSolver(FastSolver&&) noexcept;
-        FastSolver& operator=(FastSolver&&) noexcept;
-        ~FastSolver();
+    // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
+    struct FastSolverHolder {
+        std::unique_ptr<FastSolver> solver;
+        FastSolverHolder();
+        explicit FastSolverHolder(std::unique_ptr<FastSolver> s);
+        FastSolverHolder(const FastSolverHolder& other);
+        FastSolverHolder& operator=(const FastSolverHolder& other);
+        FastSolverHolder(FastSolverHolder&&) noexcept;
+        FastSolverHolder& operator=(FastSolverHolder&&) noexcept;
+        ~FastSolverHolder();
     };
 
     Topology topology_;
     State state_;
     SimulationSettings settings_;
-    FastSolver grid_;            // the fast solver, when the topology is a grid
+    FastSolverHolder fast_;      // the fast solver, when the topology is a grid
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;

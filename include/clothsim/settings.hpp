@@ -26,7 +26,7 @@ enum class Integrator {
     Xpbd,             // extended position-based dynamics, one iteration per substep, compliance 1/k
 };
 
-// Which implementation advances the cloth. Both integrate the same model; see src/core/grid_solver.hpp.
+// Which implementation advances the cloth. Both integrate the same model; see src/core/fast_solver.hpp.
 enum class SolverMethod {
     Fast,      // row sweeps over the grid: vectorised, multi-threaded, each spring once, stages fused
     Textbook,  // one loop over the spring list, one over the particles: the oracle the tests compare with
@@ -35,7 +35,7 @@ enum class SolverMethod {
 // How wind acts on the cloth.
 enum class WindModel {
     Triangles,  // pressure on each triangle along its normal: an edge-on sheet feels none, a flag flutters
-    Uniform,    // the seed's isotropic drag toward the air velocity, the same for every particle
+    Uniform,    // isotropic drag toward the air velocity, the same for every particle
 };
 
 struct ClothSettings {

@@ -1,7 +1,8 @@
 // Stability limits known before stepping, and the guard that recovers when a step blows up anyway.
 //
-// Position Verlet on a linear spring network is stable iff every mode's w h < 2 sqrt(1 - d/2) in the seed's
-// form x' = x + (x - x_prev)(1 - d) + a h^2; in clothsim's central-difference form (a h^2 divided by
+// Position Verlet on a linear spring network is stable iff every mode's w h < 2 sqrt(1 - d/2) in the drag
+// form x' = x + (x - x_prev)(1 - d) + a h^2, which damps by a fraction d of the motion per step (Jakobsen,
+// "Advanced Character Physics", GDC 2001); in clothsim's central-difference form (a h^2 divided by
 // 1 + c h / 2, d = c h / (1 + c h / 2)) the damping cancels and the condition is exactly w h < 2
 // (docs/STABILITY.md derives both). The largest mode w_max is bounded two ways:
 //  - Gershgorin: w_max^2 <= max_i sum_j 2 k_ij / m_i over particle i's springs. Always safe.

@@ -3,6 +3,7 @@
 //  - State changes every step and is laid out as structure of arrays for the hot loops.
 #pragma once
 
+#include "clothsim/settings.hpp"
 #include "clothsim/spring.hpp"
 
 #include <glm/vec3.hpp>
@@ -70,7 +71,7 @@ struct BasicState {
     T substep = T(0);             // s: the substep `motion` belongs to
     // Which integrator's convention `motion` follows: Verlet keeps x - x_prev; every other integrator keeps
     // v h, its velocity times the substep (the same displacement a substep at that velocity makes).
-    int integrator = 0;
+    Integrator integrator = Integrator::Verlet;
 
     std::size_t size() const { return position.size(); }
 };

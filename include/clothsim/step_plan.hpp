@@ -3,8 +3,8 @@
 // MassSpring builds the plan when it is constructed and again whenever its settings change (it compares
 // them with the ones the plan was made for, once per substep), never per particle. A stage that would do
 // nothing is not run at all: a spring kind with stiffness 0 or no springs, zero wind, a disabled collider,
-// no strain or speed limit. The fast solver compiles one sweep per set of spring kinds, so a skipped kind
-// costs no instruction in the hot loop (src/core/grid_solver.cpp). Gravity and damping are coefficients of
+// no strain or speed limit. The fast solver compiles one variant per set of spring kinds, so a skipped kind
+// costs no instruction in the hot loop (src/core/fast_solver.cpp). Gravity and damping are coefficients of
 // the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
 #pragma once
 
@@ -20,7 +20,7 @@ namespace clothsim {
 
 // How a substep advances the cloth.
 enum class StepPath {
-    FastSweep,          // Verlet in the fast grid solver: springs, integration fused row by row
+    Fast,               // Verlet in the fast solver: springs and integration fused row by row
     Textbook,           // Verlet over the spring list, then over the particles
     VelocityIntegrator, // symplectic Euler, RK4, implicit Euler or XPBD
 };
@@ -36,11 +36,11 @@ struct StepPlan {
 
     bool any_springs() const { return springs[0] || springs[1] || springs[2]; }
     bool any_collider() const { return sphere || cube || ground; }
-    // Bit k set when spring kind k runs: the fast solver's sweep variant.
+    // Bit k set when spring kind k runs: the fast solver's variant.
     unsigned spring_mask() const { return (springs[0] ? 1u : 0u) | (springs[1] ? 2u : 0u) | (springs[2] ? 4u : 0u); }
 };
 
-// `fast_solver` says whether the fast grid solver can run this topology.
+// `fast_solver` says whether the fast solver can run this topology.
 StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver);
 
 // Whether the wind stage exerts any force: air moving, or the uniform model's drag on a moving cloth.

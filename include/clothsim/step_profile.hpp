@@ -15,9 +15,9 @@ namespace clothsim {
 enum class Stage {
     Springs,     // spring forces (textbook solver and velocity integrators)
     Wind,        // wind forces
-    Sweep,       // fast solver: springs, gravity, damping and the Verlet update, fused row by row
+    Fast,        // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
-    BroadPhase,  // boxes of the particle blocks (when the sweep did not leave them) and of the whole cloth
+    BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth
     Sphere,      // sphere collisions (broad and narrow phase)
     Cube,        // cube collisions
     Ground,      // ground collisions

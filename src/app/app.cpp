@@ -14,6 +14,7 @@
 #include "exit_codes.hpp"
 
 #include "clothsim/atomic_file.hpp"
+#include "clothsim/data_dirs.hpp"
 #include "clothsim/scene.hpp"
 
 #include <GLFW/glfw3.h>
@@ -44,8 +45,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 std::filesystem::path texture_directory() {
-    if (const char* dir = std::getenv("CLOTHSIM_TEXTURES"); dir && *dir) return dir;
-    return CLOTHSIM_DEFAULT_TEXTURE_DIR;
+    return data_directory("CLOTHSIM_TEXTURES", CLOTHSIM_DEFAULT_TEXTURE_DIR);
 }
 
 // The 3D view: the window right of the panel, in window coordinates (x, y from the top-left, w, h).

@@ -4,6 +4,8 @@
 #include "app_state.hpp"
 #include "layout.hpp"
 
+#include "clothsim/overloaded.hpp"
+
 #include <imgui.h>
 
 #include <algorithm>
@@ -16,11 +18,6 @@
 
 namespace clothsim {
 namespace {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
 
 // Slider extents for fields whose valid range is too wide to drag through (the valid range still applies:
 // ctrl+click types any allowed value).
@@ -472,7 +469,7 @@ void stats_section(const AppState& app) {
     ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                 app.sim.time());
     // The fast solver runs position Verlet; every other integrator uses the shared textbook force path.
-    const bool fast = app.sim.plan().path == StepPath::FastSweep;
+    const bool fast = app.sim.plan().path == StepPath::Fast;
     const double per_substep_us = app.stats.substeps_last_frame > 0
                                       ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
                                       : 0.0;

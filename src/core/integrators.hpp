@@ -1,4 +1,4 @@
-// The velocity-based integrators. Position Verlet (verlet.hpp) and its fast grid solver keep
+// The velocity-based integrators. Position Verlet (verlet.hpp) and the fast solver keep
 // motion = x - x_prev; these keep motion = v h (State::integrator says which), so switching between them is
 // a restart from the current velocities. All of them get forces from the same function (springs and wind,
 // MassSpring::compute_forces) and leave collisions to the same stage after them.

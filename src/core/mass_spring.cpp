@@ -2,7 +2,7 @@
 
 #include "clothsim/colliders.hpp"
 #include "forces.hpp"
-#include "grid_solver.hpp"
+#include "fast_solver.hpp"
 #include "integrators.hpp"
 #include "verlet.hpp"
 
@@ -26,17 +26,17 @@ std::uint64_t next_stamp() {
 
 }  // namespace
 
-MassSpring::FastSolver::FastSolver() = default;
-MassSpring::FastSolver::FastSolver(std::unique_ptr<GridSolver> s) : solver(std::move(s)) {}
-MassSpring::FastSolver::FastSolver(const FastSolver& other)
-    : solver(other.solver ? std::make_unique<GridSolver>(*other.solver) : nullptr) {}
-MassSpring::FastSolver& MassSpring::FastSolver::operator=(const FastSolver& other) {
-    if (this != &other) solver = other.solver ? std::make_unique<GridSolver>(*other.solver) : nullptr;
+MassSpring::FastSolverHolder::FastSolverHolder() = default;
+MassSpring::FastSolverHolder::FastSolverHolder(std::unique_ptr<FastSolver> s) : solver(std::move(s)) {}
+MassSpring::FastSolverHolder::FastSolverHolder(const FastSolverHolder& other)
+    : solver(other.solver ? std::make_unique<FastSolver>(*other.solver) : nullptr) {}
+MassSpring::FastSolverHolder& MassSpring::FastSolverHolder::operator=(const FastSolverHolder& other) {
+    if (this != &other) solver = other.solver ? std::make_unique<FastSolver>(*other.solver) : nullptr;
     return *this;
 }
-MassSpring::FastSolver::FastSolver(FastSolver&&) noexcept = default;
-MassSpring::FastSolver& MassSpring::FastSolver::operator=(FastSolver&&) noexcept = default;
-MassSpring::FastSolver::~FastSolver() = default;
+MassSpring::FastSolverHolder::FastSolverHolder(FastSolverHolder&&) noexcept = default;
+MassSpring::FastSolverHolder& MassSpring::FastSolverHolder::operator=(FastSolverHolder&&) noexcept = default;
+MassSpring::FastSolverHolder::~FastSolverHolder() = default;
 
 MassSpring::MassSpring(Topology topology, State state, SimulationSettings settings,
                        const std::vector<glm::vec3>& initial_velocity)
@@ -55,7 +55,9 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     }
     force_.resize(n);
     state_.motion.resize(n);
-    if (auto grid = GridSolver::for_topology(topology_)) grid_ = FastSolver(std::make_unique<GridSolver>(std::move(*grid)));
+    if (auto solver = FastSolver::for_topology(topology_)) {
+        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
+    }
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
     replan();
     restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
@@ -70,12 +72,12 @@ MassSpring& MassSpring::operator=(const MassSpring&) = default;
 MassSpring::MassSpring(MassSpring&&) noexcept = default;
 MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
 
-const char* MassSpring::fast_kernel_name() { return GridSolver::kernel_name(); }
+const char* MassSpring::fast_kernel_name() { return FastSolver::kernel_name(); }
 
 int MassSpring::solver_threads() const {
-    if (plan_.path != StepPath::FastSweep) return 1;
-    const bool set_aside = settings_.solver.threads == 0 && grid_.solver->team_set_aside();
-    return set_aside ? 1 : grid_.solver->effective_threads(settings_.solver.threads);
+    if (plan_.path != StepPath::Fast) return 1;
+    const bool set_aside = settings_.solver.threads == 0 && fast_.solver->team_set_aside();
+    return set_aside ? 1 : fast_.solver->effective_threads(settings_.solver.threads);
 }
 
 float MassSpring::substep_length() const {
@@ -108,10 +110,10 @@ void MassSpring::step() {
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
     blocks_.current = blocks_.boxes_current = false;  // positions move now: last substep's boxes are stale
     const Integrator integrator = settings_.integration.integrator;
-    if (h != state_.substep || static_cast<int>(integrator) != state_.integrator) restart(velocities(), h);
+    if (h != state_.substep || integrator != state_.integrator) restart(velocities(), h);
 
     switch (plan_.path) {
-        case StepPath::FastSweep: step_fast_sweep(h, profile); break;
+        case StepPath::Fast: step_fast(h, profile); break;
         case StepPath::Textbook: step_textbook(h, profile); break;
         case StepPath::VelocityIntegrator: {
             StageTimer timer(profile, Stage::Integrate);
@@ -143,9 +145,9 @@ void MassSpring::step() {
     }
 }
 
-// Fast solver: wind first (it reads the positions before the sweep moves them), then one fused sweep that
-// also leaves each row's box for the collision broad phase.
-void MassSpring::step_fast_sweep(float h, StepProfile* profile) {
+// Fast solver: wind first (it reads the positions before the fast solver moves them), then one fused sweep
+// over the rows that also leaves each row's box for the collision broad phase.
+void MassSpring::step_fast(float h, StepProfile* profile) {
     const Vec3Array* external = nullptr;
     if (plan_.wind) {
         StageTimer timer(profile, Stage::Wind);
@@ -159,8 +161,8 @@ void MassSpring::step_fast_sweep(float h, StepProfile* profile) {
     }
     const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
     {
-        StageTimer timer(profile, Stage::Sweep);
-        grid_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr);
+        StageTimer timer(profile, Stage::Fast);
+        fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr);
     }
     blocks_.boxes_current = boxes;
     blocks_.current = false;  // the cloth's box is the union, made by the collision stage
@@ -189,7 +191,7 @@ void MassSpring::collide(StepProfile* profile) {
 }
 
 void MassSpring::replan() {
-    plan_ = plan_step(topology_, settings_, grid_.solver != nullptr);
+    plan_ = plan_step(topology_, settings_, fast_.solver != nullptr);
 }
 
 void MassSpring::wake() {
@@ -360,7 +362,7 @@ void MassSpring::run_steps(long long steps) {
 
 void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
     const Integrator integrator = settings_.integration.integrator;
-    state_.integrator = static_cast<int>(integrator);
+    state_.integrator = integrator;
     if (integrator == Integrator::Verlet) {
         compute_forces(state_, force_);
         start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
@@ -386,7 +388,7 @@ std::vector<glm::vec3> MassSpring::positions() const {
 
 std::vector<glm::vec3> MassSpring::velocities() const {
     if (asleep_) return std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f));
-    if (state_.integrator != static_cast<int>(Integrator::Verlet)) {
+    if (state_.integrator != Integrator::Verlet) {
         std::vector<glm::vec3> v(state_.size(), glm::vec3(0.0f));
         if (state_.substep > 0.0f) {
             for (std::size_t i = 0; i < v.size(); ++i) v[i] = state_.motion.get(i) / state_.substep;

@@ -1,6 +1,8 @@
 // The one place that says each scene field's unit, valid range and meaning. The loader, --set, validate(),
-// to_toml(), the README's field list and (later) the panel's tooltips all read this table.
+// to_toml(), the README's field list and the panel's tooltips all read this table.
 #include "clothsim/scene.hpp"
+
+#include "clothsim/overloaded.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -98,13 +100,6 @@ std::string cat(const Parts&... parts) {
 }
 
 std::string range(const FieldInfo& f) { return cat("[", number(f.min), ", ", number(f.max), "]"); }
-
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;  // C++20 deduces this itself; clang before 17 needs it spelled out
 
 }  // namespace
 

@@ -2,6 +2,9 @@
 // table (scene_fields.cpp) so a bad value is reported with its source, line, field and allowed range.
 #include "clothsim/scene.hpp"
 
+#include "clothsim/data_dirs.hpp"
+#include "clothsim/overloaded.hpp"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -24,13 +27,6 @@
 
 namespace clothsim {
 namespace {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;  // C++20 deduces this itself; clang before 17 needs it spelled out
 
 // Arrays, tables and floats are written here, not by toml++'s formatter: toml++ 3.3 sizes arrays and
 // tables with static_cast<size_t>(log10(|x|)) per element, undefined behaviour for inf, nan, |x| < 1 and
@@ -339,8 +335,7 @@ Scene load_scene_file(const std::filesystem::path& path) {
 }
 
 std::filesystem::path scene_directory() {
-    if (const char* dir = std::getenv("CLOTHSIM_SCENES"); dir && *dir) return dir;
-    return CLOTHSIM_DEFAULT_SCENE_DIR;
+    return data_directory("CLOTHSIM_SCENES", CLOTHSIM_DEFAULT_SCENE_DIR);
 }
 
 std::vector<std::string> bundled_scene_names() {

@@ -6,7 +6,7 @@ std::string_view stage_name(Stage stage) {
     switch (stage) {
         case Stage::Springs: return "springs";
         case Stage::Wind: return "wind";
-        case Stage::Sweep: return "sweep";
+        case Stage::Fast: return "fast solver";
         case Stage::Integrate: return "integrate";
         case Stage::BroadPhase: return "broad phase";
         case Stage::Sphere: return "sphere";
@@ -42,7 +42,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     if (settings.integration.integrator != Integrator::Verlet) {
         plan.path = StepPath::VelocityIntegrator;
     } else {
-        plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::FastSweep
+        plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::Fast
                                                                                  : StepPath::Textbook;
     }
     const float k[kSpringKindCount] = {settings.springs.structural, settings.springs.shear, settings.springs.bending};
@@ -90,14 +90,14 @@ std::string_view state_name(StageState state) {
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings) {
     using enum StageState;
     std::vector<StageStatus> out;
-    const bool fast = plan.path == StepPath::FastSweep;
+    const bool fast = plan.path == StepPath::Fast;
     const bool velocity = plan.path == StepPath::VelocityIntegrator;
     const std::string springs = spring_note(plan, topology);
     auto when = [](bool runs, StageState otherwise) { return runs ? Runs : otherwise; };
     if (!plan.any_springs()) {
         out.push_back({Stage::Springs, Skipped, springs});
     } else if (fast) {
-        out.push_back({Stage::Springs, Fused, "in the sweep: " + springs});
+        out.push_back({Stage::Springs, Fused, "in the fast solver: " + springs});
     } else if (velocity) {
         out.push_back({Stage::Springs, Fused, "in the integrate stage (evaluated per force call): " + springs});
     } else {
@@ -108,16 +108,16 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     } else {
         out.push_back({Stage::Wind, velocity ? Fused : Runs, velocity ? "in the integrate stage" : ""});
     }
-    out.push_back({Stage::Sweep, when(fast, Skipped),
+    out.push_back({Stage::Fast, when(fast, Skipped),
                    fast ? "springs, gravity, damping and the Verlet update, row by row"
                         : (velocity ? "the integrator is not verlet" : "solver.method is textbook (or the cloth is no grid)")});
-    out.push_back({Stage::Integrate, fast ? Fused : Runs, fast ? "in the sweep" : ""});
+    out.push_back({Stage::Integrate, fast ? Fused : Runs, fast ? "in the fast solver" : ""});
     if (!plan.any_collider()) {
         out.push_back({Stage::BroadPhase, Skipped, "no collider is enabled"});
     } else if (!settings.solver.broad_phase) {
         out.push_back({Stage::BroadPhase, Skipped, "solver.broad_phase is false"});
     } else {
-        out.push_back({Stage::BroadPhase, Runs, fast ? "the cloth's box (the sweep boxes the blocks)" : "boxes of the blocks and the cloth"});
+        out.push_back({Stage::BroadPhase, Runs, fast ? "the cloth's box (the fast solver boxes the blocks)" : "boxes of the blocks and the cloth"});
     }
     const char* culled = settings.solver.broad_phase ? "blocks whose box meets it" : "every particle (broad phase off)";
     out.push_back({Stage::Sphere, when(plan.sphere, Skipped), plan.sphere ? culled : "colliders.sphere.enabled is false"});

@@ -1,12 +1,13 @@
 // TeamChoice: whether the fast solver's thread team is worth its barriers right now.
 //
 // OpenMP's barrier spins for a while, then sleeps. When another process holds one of the team's cores, the
-// descheduled thread reaches the barrier a scheduler slice late, every substep: a 40 x 40 drape went from
-// 0.85 ms to over 100 ms per step while a test suite ran beside it. With solver.threads = 0 the solver
-// therefore keeps a running estimate of a substep's time with the team and with one thread, times one
-// substep the other way now and then (a probe), and uses whichever is faster. A probe that loses doubles the
-// wait before the next one (64 to 4096 substeps), so a team that stays slow costs little to keep checking.
-// Results are bit-identical for any thread count (grid_solver.hpp), so switching never changes the cloth.
+// descheduled thread reaches the barrier a scheduler slice late, every substep, and the team is far slower
+// than one thread (docs/PERFORMANCE.md has the figures). With solver.threads = 0 the solver therefore keeps a
+// running estimate of a substep's time with the team and with one thread, now and then runs a few substeps
+// the other way (a probe, timed on its last substep), and uses whichever is faster. A probe that loses
+// doubles the wait before the next one (64 to 4096 substeps), so a team that stays slow costs little to keep
+// checking. Results are bit-identical for any thread count (fast_solver.hpp), so switching never changes the
+// cloth.
 #pragma once
 
 #include <algorithm>

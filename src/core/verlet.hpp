@@ -2,7 +2,8 @@
 //
 // The model is x'' = a - c x' (a = F/m + g, c the damping rate in 1/s). Central differences,
 //   (x' - 2x + x_prev) / h^2 = a - c (x' - x_prev) / (2h),
-// give x' = [2x - (1 - c h/2) x_prev + a h^2] / (1 + c h/2), which is the seed's form
+// give x' = [2x - (1 - c h/2) x_prev + a h^2] / (1 + c h/2), which is the per-step drag form (Jakobsen,
+// "Advanced Character Physics", GDC 2001)
 //   x' = x + (x - x_prev)(1 - d) + a h^2 / (1 + c h/2)   with   d = c h / (1 + c h/2).
 // d is derived from c and h each step, so the damping a user sees does not change when h changes, and the
 // scheme stays second order with damping on.

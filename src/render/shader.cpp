@@ -1,8 +1,9 @@
 #include "shader.hpp"
 
+#include "clothsim/data_dirs.hpp"
+
 #include <glm/gtc/type_ptr.hpp>
 
-#include <cstdlib>
 #include <fstream>
 #include <cctype>
 #include <sstream>
@@ -87,8 +88,7 @@ std::string annotate_log(const std::string& log, const std::string& file) {
 }
 
 std::filesystem::path shader_directory() {
-    if (const char* dir = std::getenv("CLOTHSIM_SHADERS"); dir && *dir) return dir;
-    return CLOTHSIM_DEFAULT_SHADER_DIR;
+    return data_directory("CLOTHSIM_SHADERS", CLOTHSIM_DEFAULT_SHADER_DIR);
 }
 
 Shader::Shader(const std::filesystem::path& vertex, const std::filesystem::path& fragment) {

@@ -145,10 +145,10 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
     CHECK(stage.size() == 11);
-    // drape-sphere: fast sweep, sphere and ground, no wind, no cube, no limits.
-    CHECK(stage.at("sweep").at("state") == "runs");
-    CHECK(stage.at("sweep").at("substeps_run") == 30 * 38);
-    CHECK(stage.at("sweep").at("ms").get<double>() > 0.0);
+    // drape-sphere: fast solver, sphere and ground, no wind, no cube, no limits.
+    CHECK(stage.at("fast solver").at("state") == "runs");
+    CHECK(stage.at("fast solver").at("substeps_run") == 30 * 38);
+    CHECK(stage.at("fast solver").at("ms").get<double>() > 0.0);
     CHECK(stage.at("springs").at("state") == "fused");
     CHECK(stage.at("sphere").at("state") == "runs");
     CHECK(stage.at("sphere").at("blocks_offered") == 30 * 38 * 120);  // 40 rows of 3 blocks
@@ -173,7 +173,7 @@ TEST_CASE("cli: a headless run reports when the cloth slept, and bending 0 as a 
                                       "springs.damping=4", "--set", "springs.bending=0", "--duration", "20"});
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
-    CHECK_THAT(r.out, Contains("stages, ms per step: sweep"));
+    CHECK_THAT(r.out, Contains("stages, ms per step: fast solver"));
     CHECK_THAT(r.out, Contains("bending: stiffness 0"));
     CHECK_THAT(r.out, Contains("(asleep at the end)"));
 }

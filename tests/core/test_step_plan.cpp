@@ -94,8 +94,8 @@ TEST_CASE("step_plan a spring kind with stiffness 0 moves the cloth bit for bit 
             if (method == SolverMethod::Fast) {
                 // A topology missing a whole spring kind is still a grid: the fast solver must run it.
                 CHECK(without_kind.fast_solver_available());
-                CHECK(without_kind.plan().path == StepPath::FastSweep);
-                CHECK(with_kind.plan().path == StepPath::FastSweep);
+                CHECK(without_kind.plan().path == StepPath::Fast);
+                CHECK(with_kind.plan().path == StepPath::Fast);
             }
             const std::vector<glm::vec3> start = with_kind.positions();
             step_n(with_kind, 60);
@@ -110,7 +110,7 @@ TEST_CASE("step_plan fast and textbook solvers agree bit for bit for every set o
           "[step_plan]") {
     for (unsigned mask = 0; mask < 8; ++mask) {
         // Kinds switched off from the start, and switched off live after 100 substeps with every kind on (the
-        // sweep variant changes under a running solver).
+        // fast solver's variant changes while it runs).
         for (int before : {0, 100}) {
             INFO("spring mask " << mask << " (bit 0 structural, 1 shear, 2 bending) after " << before
                                 << " substeps with every kind");
@@ -127,7 +127,7 @@ TEST_CASE("step_plan fast and textbook solvers agree bit for bit for every set o
                 CHECK(sim.plan().spring_mask() == mask);
                 step_n(sim, 39);
             }
-            CHECK(runs[0].plan().path == StepPath::FastSweep);
+            CHECK(runs[0].plan().path == StepPath::Fast);
             CHECK(runs[1].plan().path == StepPath::Textbook);
             require_same_positions(runs[0], runs[1]);
         }
@@ -254,7 +254,7 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     s.colliders.ground.enabled = false;
 
     StepPlan p = plan_step(t, s, true);
-    CHECK(p.path == StepPath::FastSweep);
+    CHECK(p.path == StepPath::Fast);
     CHECK(p.spring_mask() == 7u);
     CHECK_FALSE(p.wind);
     CHECK_FALSE(p.any_collider());
@@ -262,7 +262,7 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     CHECK_FALSE(p.speed_limit);
     CHECK_FALSE(p.may_sleep);  // small_hanging turns sleeping off
 
-    CHECK(plan_step(t, s, false).path == StepPath::Textbook);  // no grid solver for this topology
+    CHECK(plan_step(t, s, false).path == StepPath::Textbook);  // no fast solver for this topology
     s.solver.method = SolverMethod::Textbook;
     CHECK(plan_step(t, s, true).path == StepPath::Textbook);
     s.solver.method = SolverMethod::Fast;
@@ -319,7 +319,7 @@ TEST_CASE("step_plan a setting applied to a live simulation replans at the point
     CHECK_FALSE(sim.plan().springs[2]);  // at once, not at the next step
     sim.step();
     CHECK_FALSE(sim.plan().springs[2]);
-    CHECK(sim.plan().path == StepPath::FastSweep);
+    CHECK(sim.plan().path == StepPath::Fast);
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.strain_limit = 0.1f; });
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.sphere.enabled = true; });
@@ -377,7 +377,7 @@ TEST_CASE("step_plan describe lists every stage once and names the setting that 
         CHECK(springs.state == (method == SolverMethod::Fast ? StageState::Fused : StageState::Runs));
         CHECK(springs.note.find("bending: stiffness 0") != std::string::npos);
         CHECK(springs.note.find("structural") != std::string::npos);
-        CHECK(status_of(statuses, Stage::Sweep).state ==
+        CHECK(status_of(statuses, Stage::Fast).state ==
               (method == SolverMethod::Fast ? StageState::Runs : StageState::Skipped));
         CHECK(status_of(statuses, Stage::Integrate).state ==
               (method == SolverMethod::Fast ? StageState::Fused : StageState::Runs));
@@ -423,19 +423,19 @@ TEST_CASE("step_plan the profile counts each stage that runs once per substep an
         CHECK(p.runs_of(skipped) == 0);
         CHECK(p.ms_of(skipped) == 0.0);
     }
-    for (Stage runs : {Stage::Sweep, Stage::Ground}) {
+    for (Stage runs : {Stage::Fast, Stage::Ground}) {
         INFO("stage " << stage_name(runs));
         CHECK(p.runs_of(runs) == kSubsteps);
         CHECK(p.ms_of(runs) > 0.0);
     }
     CHECK(p.blocks_offered[2] == static_cast<long long>(12 * blocks_per_row(12) * kSubsteps));
 
-    // The textbook path times its spring and integration stages instead of the sweep.
+    // The textbook path times its spring and integration stages instead of the fast solver's fused stage.
     MassSpring textbook = build_simulation(small_hanging(SolverMethod::Textbook));
     step_n(textbook, kSubsteps);
     CHECK(textbook.profile().runs_of(Stage::Springs) == kSubsteps);
     CHECK(textbook.profile().runs_of(Stage::Integrate) == kSubsteps);
-    CHECK(textbook.profile().runs_of(Stage::Sweep) == 0);
+    CHECK(textbook.profile().runs_of(Stage::Fast) == 0);
 
     // The sleep check runs once per step when the cloth may sleep.
     Scene sleepy = scene;
@@ -458,7 +458,7 @@ TEST_CASE("step_plan the profile counts each stage that runs once per substep an
     CHECK(sim.profile().total_ms() == 0.0);
     sim.set_profiling(true);
     step_n(sim, 1);
-    CHECK(sim.profile().runs_of(Stage::Sweep) == 1);
+    CHECK(sim.profile().runs_of(Stage::Fast) == 1);
 }
 
 namespace {

@@ -1,4 +1,4 @@
-#include "grid_solver.hpp"
+#include "fast_solver.hpp"
 
 #include "clothsim/broad_phase.hpp"
 #include "verlet.hpp"
@@ -81,27 +81,34 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, cons
     spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
+// Asked of the CPU once, on first use.
 bool cpu_has_avx2_fma() {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    static const bool has_avx2_fma = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    }();
+    return has_avx2_fma;
 }
 
-// Chosen once at start-up from the CPU; tests switch to the generic kernel to check it too.
-bool kAvx2 = cpu_has_avx2_fma();
+// Set by force_generic_kernel: the tests run the generic kernel on an AVX2 CPU to check it too.
+bool generic_kernel_forced = false;
+
+// Whether the AVX2 + FMA kernels run: the CPU has them and no test asked for the generic ones.
+bool use_avx2() { return cpu_has_avx2_fma() && !generic_kernel_forced; }
 
 }  // namespace
 
-const char* GridSolver::kernel_name() { return kAvx2 ? "avx2+fma" : "generic"; }
+const char* FastSolver::kernel_name() { return use_avx2() ? "avx2+fma" : "generic"; }
 
-bool GridSolver::force_generic_kernel(bool generic) {
-    const bool was_avx2 = kAvx2;
-    kAvx2 = !generic && cpu_has_avx2_fma();
-    return !was_avx2;
+bool FastSolver::force_generic_kernel(bool generic) {
+    const bool was_generic = !use_avx2();
+    generic_kernel_forced = generic;
+    return was_generic;
 }
 
-std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
+std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     if (t.rows < 1 || t.cols < 1) return std::nullopt;
-    GridSolver solver(t.rows, t.cols);
+    FastSolver solver(t.rows, t.cols);
     const std::size_t n = static_cast<std::size_t>(t.rows) * t.cols;
     // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
     // exactly one spring for the sweep to be the same model as the spring list.
@@ -142,15 +149,15 @@ std::optional<GridSolver> GridSolver::for_topology(const Topology& t) {
     return solver;
 }
 
-int GridSolver::effective_threads(int requested) const {
-    // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, about 6 us,
-    // and this runs every substep (it was half the CPU time of a small cloth's soak run).
+int FastSolver::effective_threads(int requested) const {
+    // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, and this
+    // runs every substep (docs/PERFORMANCE.md and docs/RELIABILITY.md have the cost).
     static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     const int wanted = requested > 0 ? requested : cores;
     return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
 }
 
-void GridSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
+void FastSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
                       const Vec3Array* external, float h, std::vector<Box>* row_boxes) {
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
@@ -388,17 +395,17 @@ constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...
 
 }  // namespace
 
-void GridSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
+void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
     const Grid grid{rows_, cols_, rest_, present_};
-    spring_row_table(kAvx2, std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
+    spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
-void GridSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
+void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
-    sweep_table(kAvx2, std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
+    sweep_table(use_avx2(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }
 
 }  // namespace clothsim

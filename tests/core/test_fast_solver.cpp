@@ -1,6 +1,6 @@
-// The fast grid solver against the textbook solver (the oracle), determinism across thread counts, and
+// The fast solver against the textbook solver (the oracle), determinism across thread counts, and
 // the fallbacks (generic kernel, non-grid topologies).
-#include "grid_solver.hpp"
+#include "fast_solver.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -42,25 +42,25 @@ bool bit_identical(const MassSpring& a, const MassSpring& b) {
 
 }  // namespace
 
-TEST_CASE("grid_solver agrees with the textbook solver to 1e-5 of the cloth size after 1000 steps", "[grid_solver]") {
+TEST_CASE("fast solver agrees with the textbook solver to 1e-5 of the cloth size after 1000 steps", "[fast_solver]") {
     for (const std::string& name : bundled_scene_names()) {
         const Scene scene = load_scene(name);
         const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
         const MassSpring fast = run(scene, SolverMethod::Fast, 2, 1000);
         const double difference = max_relative_difference(textbook, fast, scene);
-        INFO(name << ": max |x_fast - x_textbook| / size = " << difference << " (kernel " << GridSolver::kernel_name()
+        INFO(name << ": max |x_fast - x_textbook| / size = " << difference << " (kernel " << FastSolver::kernel_name()
                   << ")");
         CHECK(difference < 1e-5);
         // Stronger, and by design: both solvers do the same operations in the same order (see
-        // grid_solver.cpp), so they agree bit for bit; rounding differences would otherwise grow
+        // fast_solver.cpp), so they agree bit for bit; rounding differences would otherwise grow
         // exponentially in wrinkling cloth (measured: 1e-9 after 2 substeps, 2e-3 after 1000).
         CHECK(difference == 0.0);
         CHECK(fast.all_finite());
     }
 }
 
-TEST_CASE("grid_solver generic kernel agrees with the textbook solver too", "[grid_solver]") {
-    const bool was_generic = GridSolver::force_generic_kernel(true);
+TEST_CASE("fast solver generic kernel agrees with the textbook solver too", "[fast_solver]") {
+    const bool was_generic = FastSolver::force_generic_kernel(true);
     for (const char* name : {"hanging", "drape-sphere", "flag"}) {
         const Scene scene = load_scene(name);
         const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
@@ -68,10 +68,10 @@ TEST_CASE("grid_solver generic kernel agrees with the textbook solver too", "[gr
         INFO(name << " with the generic kernel");
         CHECK(max_relative_difference(textbook, fast, scene) == 0.0);
     }
-    GridSolver::force_generic_kernel(was_generic);
+    FastSolver::force_generic_kernel(was_generic);
 }
 
-TEST_CASE("grid_solver gives bit-identical positions for any thread count", "[grid_solver]") {
+TEST_CASE("fast solver gives bit-identical positions for any thread count", "[fast_solver]") {
     for (const char* name : {"flag", "drape-cube", "curtain"}) {
         Scene scene = load_scene(name);
         scene.cloth.rows = 64;  // enough rows for several blocks (8 rows at least each)
@@ -86,7 +86,7 @@ TEST_CASE("grid_solver gives bit-identical positions for any thread count", "[gr
     }
 }
 
-TEST_CASE("grid_solver keeps pins fixed and every particle outside the colliders", "[grid_solver]") {
+TEST_CASE("fast solver keeps pins fixed and every particle outside the colliders", "[fast_solver]") {
     Scene scene = load_scene("drape-sphere");
     scene.pins.particles = {{0, 0}, {39, 39}};
     MassSpring sim = run(scene, SolverMethod::Fast, 2, 0);
@@ -102,19 +102,19 @@ TEST_CASE("grid_solver keeps pins fixed and every particle outside the colliders
     }
 }
 
-TEST_CASE("grid_solver is only used for grid topologies; others run the textbook path", "[grid_solver]") {
+TEST_CASE("fast solver is only used for grid topologies; others run the textbook path", "[fast_solver]") {
     Topology t;
     t.rows = 1;
     t.cols = 3;
     t.springs = {{0, 2, 1.0f, SpringKind::Structural}};  // two apart but structural: not a grid spring
-    CHECK_FALSE(GridSolver::for_topology(t).has_value());
+    CHECK_FALSE(FastSolver::for_topology(t).has_value());
     t.springs = {{0, 1, 1.0f, SpringKind::Structural}, {1, 0, 1.0f, SpringKind::Structural}};  // a duplicate
-    CHECK_FALSE(GridSolver::for_topology(t).has_value());
+    CHECK_FALSE(FastSolver::for_topology(t).has_value());
     t.springs = {{0, 1, 1.0f, SpringKind::Structural}};  // the spring (1, 2) is missing
-    CHECK_FALSE(GridSolver::for_topology(t).has_value());
+    CHECK_FALSE(FastSolver::for_topology(t).has_value());
     t.springs = {{1, 0, 1.0f, SpringKind::Structural}, {2, 1, 1.0f, SpringKind::Structural},
                  {0, 2, 2.0f, SpringKind::Bending}};  // either end may come first
-    CHECK(GridSolver::for_topology(t).has_value());
+    CHECK(FastSolver::for_topology(t).has_value());
 
     const State st = test::free_particles({{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {2.5f, 0.0f, 0.0f}}, 1.0f);
     Topology odd;
@@ -131,7 +131,7 @@ TEST_CASE("grid_solver is only used for grid topologies; others run the textbook
     CHECK(sim.position(1).x == 1.0f);
 }
 
-TEST_CASE("grid_solver steps every row block when OpenMP gives fewer threads than blocks", "[grid_solver]") {
+TEST_CASE("fast solver steps every row block when OpenMP gives fewer threads than blocks", "[fast_solver]") {
     // Inside an active parallel region (nested parallelism off by default) the solver's own region gets a
     // team of one thread: every block must still be stepped, and bit-identically.
     Scene scene = load_scene("hanging");
@@ -149,7 +149,7 @@ TEST_CASE("grid_solver steps every row block when OpenMP gives fewer threads tha
     CHECK(bit_identical(one, nested));
 }
 
-TEST_CASE("grid solver: automatic threads switch between the team and one thread without changing a bit") {
+TEST_CASE("fast solver: automatic threads switch between the team and one thread without changing a bit") {
     Scene s = load_scene("drape-sphere");
     s.settings.solver.threads = 0;
     MassSpring automatic = build_simulation(s);

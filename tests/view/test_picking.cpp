@@ -195,7 +195,7 @@ TEST_CASE("picking pick_particle finds nothing in nothing") {
     CHECK_FALSE(pick_particle(ray, far_off, 0.1f).has_value());
 }
 
-TEST_CASE("picking pick_particle returns the particle nearest the eye: a closer one hides a farther one") {
+TEST_CASE("picking pick_particle: a particle in front hides one behind it") {
     const Ray ray{glm::vec3(1.0f, 2.0f, 3.0f), glm::normalize(glm::vec3(1.0f, -0.5f, -2.0f))};
     const glm::vec3 near_p = ray.origin + 2.0f * ray.direction;
     const glm::vec3 far_p = ray.origin + 6.0f * ray.direction;
@@ -210,7 +210,7 @@ TEST_CASE("picking pick_particle returns the particle nearest the eye: a closer 
         CHECK(pick_particle(ray, ps, 0.02f) == std::optional<std::size_t>(0));
     }
     {
-        // Nearest the eye wins even over one more exactly on the ray, as long as both are in the cone.
+        // A particle well in front hides one exactly on the ray, as long as both are in the cone.
         const glm::vec3 right_on = ray.origin + 5.0f * ray.direction;
         const glm::vec3 perp = glm::normalize(glm::cross(ray.direction, glm::vec3(0.0f, 1.0f, 0.0f)));
         const glm::vec3 edge = ray.origin + 3.0f * ray.direction + perp * (0.015f * 3.0f);
@@ -400,5 +400,59 @@ TEST_CASE("picking a 5x5 grid through a framed camera: the pixel of particle k p
                 CHECK_FALSE(pick_particle(between, positions, spread).has_value());
             }
         }
+    }
+}
+
+TEST_CASE("picking a dense cloth: the pixel of a particle picks that particle, not a neighbour nearer the eye") {
+    // Curtain-like: 40 x 48 over 1.2 m, neighbours 3 cm apart (about 7 px at 1280 x 720), seen from the
+    // side and from above, so a 10 px cone holds several particles at various depths.
+    std::vector<glm::vec3> positions;
+    const int rows = 40, cols = 48;
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+            positions.push_back({-0.6f + 0.025f * static_cast<float>(c), 2.0f - 0.025f * static_cast<float>(r),
+                                 0.002f * static_cast<float>(r % 3)});
+    glm::vec3 lo = positions[0], hi = positions[0];
+    for (const glm::vec3& p : positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const glm::vec4 rect = view_rect(glm::vec2(1280.0f, 720.0f), kPanelWidth);
+    const glm::vec2 viewport(rect.z, rect.w);
+    for (glm::vec2 turn : {glm::vec2(0.0f), glm::vec2(60.0f, 0.0f), glm::vec2(-40.0f, 30.0f)}) {
+        OrbitCamera c = framed_camera(lo, hi, viewport.x / viewport.y);
+        c.orbit(turn);
+        const float spread = pick_spread(c, 10.0f, viewport.y);
+        long long wrong = 0;
+        for (std::size_t k = 0; k < positions.size(); ++k) {
+            const Ray ray = ray_through(c, glm::vec2(project(c, positions[k], viewport)), viewport);
+            wrong += pick_particle(ray, positions, spread) != std::optional<std::size_t>(k);
+        }
+        CAPTURE(turn.x, turn.y);
+        CHECK(wrong == 0);
+    }
+}
+
+TEST_CASE("picking a layer behind the visible one is not picked through it") {
+    // A dense front sheet (1 cm apart, closer than the 10 px cone) and a coarse one 0.5 m behind; the cursor
+    // on a back particle's pixel, with the front sheet covering it, picks the front sheet.
+    std::vector<glm::vec3> positions;
+    for (int r = 0; r < 10; ++r)
+        for (int c = 0; c < 10; ++c) positions.push_back({0.05f * static_cast<float>(c), 0.05f * static_cast<float>(r), -0.5f});
+    const std::size_t front_begin = positions.size();
+    for (int r = 0; r < 50; ++r)
+        for (int c = 0; c < 50; ++c) positions.push_back({0.01f * static_cast<float>(c), 0.01f * static_cast<float>(r), 0.0f});
+    OrbitCamera cam;  // in front of the sheets, looking along -z
+    cam.target = {0.245f, 0.245f, -0.25f};
+    cam.distance = 1.5f;
+    cam.yaw = 0.0f;
+    cam.pitch = 0.0f;
+    const glm::vec2 viewport(1280.0f, 720.0f);
+    const float spread = pick_spread(cam, 10.0f, viewport.y);
+    for (std::size_t back : {std::size_t(55), std::size_t(33), std::size_t(77)}) {
+        const Ray ray = ray_through(cam, glm::vec2(project(cam, positions[back], viewport)), viewport);
+        const auto hit = pick_particle(ray, positions, spread);
+        REQUIRE(hit.has_value());
+        CHECK(*hit >= front_begin);
     }
 }

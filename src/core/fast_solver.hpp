@@ -7,8 +7,10 @@
 //    has it, chosen at run time; plain C++ otherwise) and each spring is computed once.
 //  - One pass over the rows does everything a substep needs. Row q's force is complete once the spring
 //    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
-//    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it (position
-//    Verlet) and collides it in place right then. Every particle's data is read and written once.
+//    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it in place
+//    (position Verlet) and, while the row is still in L1, writes the boxes of its particle blocks for the
+//    collision broad phase. Every particle's data is read and written once. Collisions are not part of the
+//    sweep: the caller's collision stage runs after it (collide_stage in colliders.hpp).
 //  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
 //    two spring rows just above it; they are computed before a barrier into shared storage and both
 //    neighbouring threads use the stored values. Each particle's force is summed in the same order for
@@ -26,11 +28,11 @@
 
 namespace clothsim {
 
-class GridSolver {
+class FastSolver {
 public:
     // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions, each
     // direction either complete or absent (a cloth built without bending springs).
-    static std::optional<GridSolver> for_topology(const Topology& topology);
+    static std::optional<FastSolver> for_topology(const Topology& topology);
 
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
@@ -51,7 +53,7 @@ public:
     static bool force_generic_kernel(bool generic);
 
 private:
-    GridSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
+    FastSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
 
     struct Scratch {
         std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)

@@ -11,9 +11,10 @@
 
 namespace clothsim {
 
-// The particle nearest the eye among those in front of the ray origin whose distance from the ray is at
-// most `spread` times their depth along it: a cone, so the tolerance is the same number of pixels near
-// and far (spread = pixels * 2 tan(fov_y / 2) / viewport height).
+// The particle under the cursor: among the particles in front of the ray origin whose distance from the
+// ray is at most `spread` times their depth along it (a cone, so the tolerance is the same number of pixels
+// near and far: spread = pixels * 2 tan(fov_y / 2) / viewport height), those on the visible surface (within
+// a slab behind the nearest one), and of those the nearest the ray on screen.
 std::optional<std::size_t> pick_particle(const Ray& ray, std::span<const glm::vec3> positions, float spread);
 
 // `spread` for a tolerance of `pixels` on screen.

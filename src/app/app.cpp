@@ -158,6 +158,10 @@ bool simulate(AppState& app, double wall_seconds, bool scripted) {
     }
     app.step_once = false;
     const bool restart = report_guard(app, report);
+    if (report.skipped_non_finite) {
+        app.say("the cloth is no longer finite (NaN or infinite positions) and is not stepped; R restarts the scene",
+                true);
+    }
     if (report.steps > 0) record_plots(app, was_resting && app.sim.resting());
     app.stats.dropped_seconds += report.dropped_seconds;
     app.stats.profile = app.sim.profile();
@@ -231,6 +235,9 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
         app.camera.orbit(delta);
     }
     if (io.MouseWheel != 0.0f) app.camera.zoom(io.MouseWheel);
+    // A ground that collides is solid: the camera never goes under it.
+    const GroundCollider& ground = app.sim.settings().colliders.ground;
+    if (ground.enabled) app.camera.keep_above(ground.height);
 }
 
 // Key presses collected by a GLFW callback. ImGui 1.86 (before its 1.87 input queue) sees only the key

@@ -43,6 +43,13 @@ void OrbitCamera::zoom(float wheel_steps) {
     distance = std::clamp(distance * std::pow(0.9f, wheel_steps), 0.05f, 0.5f * far_plane);
 }
 
+void OrbitCamera::keep_above(float height) {
+    target.y = std::max(target.y, height);
+    // eye.y = target.y + distance sin(pitch)
+    const float lowest = std::asin(std::clamp((height + 0.01f - target.y) / distance, -1.0f, 1.0f));
+    pitch = std::clamp(std::max(pitch, lowest), -kMaxPitch, kMaxPitch);
+}
+
 void OrbitCamera::frame(glm::vec3 box_min, glm::vec3 box_max, float aspect) {
     target = 0.5f * (box_min + box_max);
     const float radius = std::max(0.5f * glm::length(box_max - box_min), 0.01f);

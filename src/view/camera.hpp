@@ -29,6 +29,9 @@ struct OrbitCamera {
     void orbit(glm::vec2 delta_px, float radians_per_pixel = 0.008f);
     void pan(glm::vec2 delta_px, float viewport_height_px);
     void zoom(float wheel_steps);
+    // Keeps the eye above the plane y = height (the ground): the target is raised to it, and the pitch to
+    // the lowest that leaves the eye 1 cm above it.
+    void keep_above(float height);
     // Looks at the centre of a box from the current direction, from just far enough to see all of it.
     void frame(glm::vec3 box_min, glm::vec3 box_max, float aspect);
 };

@@ -380,3 +380,25 @@ TEST_CASE("camera framed_camera is the default camera framed") {
         check_near(c.target, 0.5f * (lo + hi), 1e-6f);
     }
 }
+
+TEST_CASE("camera keep_above: orbiting or panning down never takes the eye under the ground") {
+    OrbitCamera c;
+    c.target = {0.0f, 0.5f, 0.0f};
+    c.distance = 3.0f;
+    for (int i = 0; i < 200; ++i) {
+        c.orbit(glm::vec2(3.0f, -20.0f));  // drag up: the eye goes down
+        c.keep_above(0.0f);
+        CHECK(c.eye().y >= 0.0f);
+    }
+    CHECK(c.eye().y == Approx(0.01f).margin(1e-4));  // it ends just above the ground, looking level-ish
+    c.pan(glm::vec2(0.0f, -5000.0f), 720.0f);  // pan far down: the target goes under
+    c.keep_above(0.0f);
+    CHECK(c.target.y >= 0.0f);
+    CHECK(c.eye().y >= 0.0f);
+    // Above the ground nothing changes.
+    OrbitCamera high;
+    const OrbitCamera before = high;
+    high.keep_above(-1.0f);
+    CHECK(high.pitch == before.pitch);
+    CHECK(high.target == before.target);
+}

@@ -24,9 +24,10 @@ Contact<T> contact(const SphereCollider& sphere, glm::vec<3, T> p, T thickness) 
     const glm::vec<3, T> d = p - glm::vec<3, T>(sphere.center);
     Contact<T> c;
     const T reach = T(sphere.radius) + thickness;
-    // Clearly outside (by a relative 1e-5, far beyond sqrt's rounding): no contact, no square root.
+    // Clearly outside (by a relative 1e-5, far beyond sqrt's rounding): no contact, no square root. The
+    // depth says only what is known without it: at least at the shell (0).
     if (glm::dot(d, d) > reach * reach * T(1.00001)) {
-        c.depth = T(-1);
+        c.depth = T(0);
         return c;
     }
     const T length = glm::length(d);
@@ -160,7 +161,14 @@ T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thicknes
         // particle stops where its path (x - motion -> x: the motion is the substep's displacement for every
         // integrator) entered the shell, the inward part of its motion removed as in any inelastic contact;
         // no friction on this rare path.
-        if (!(c.depth > T(0)) || glm::dot(c.normal, motion) > T(0)) {
+        // Cheap filters first: outside, the path must be long enough to reach the solid (the shell's
+        // distance, as far as `contact` knows it, plus the thickness); inside, moving outward, it must be longer than the depth (it may have
+        // come in from the other side).
+        const T reach = thickness - std::min(c.depth, T(0));
+        const bool may_have_passed = c.depth > T(0)
+                                         ? glm::dot(c.normal, motion) > T(0) && glm::dot(motion, motion) > c.depth * c.depth
+                                         : glm::dot(motion, motion) > reach * reach;
+        if (may_have_passed) {
             const Vec p1 = state.position.get(i), p0 = p1 - motion;
             const auto hit = contact(shape, p0, thickness).depth > T(0) ? std::nullopt
                                                                           : swept_hit(shape, p0, p1, thickness);
@@ -171,8 +179,8 @@ T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thicknes
                 state.motion.set(i, motion - std::min(glm::dot(motion, hit->normal), T(0)) * hit->normal);
                 continue;
             }
-            if (!(c.depth > T(0))) continue;
         }
+        if (!(c.depth > T(0))) continue;
         deepest = std::max(deepest, c.depth);
         const T normal_motion = glm::dot(motion, c.normal);
         const Vec tangential = motion - normal_motion * c.normal;
@@ -254,16 +262,16 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         StageTimer timer(profile, Stage::BroadPhase);
         const bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
         blocks.boxes.resize(count);
+        // Swept boxes: grown by the cloth's largest motion per axis, they also hold where the substep started
+        // (x - motion), so a particle that passed through a collider in one substep is still offered to it
+        // (continuous collision). One bound for the cloth costs one vectorised pass, not one per block.
+        const Box motion = particle_bounds(state.motion, 0, state.size());
+        const glm::vec3 reach = motion.empty() ? glm::vec3(0.0f) : glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
         for (std::size_t k = 0; k < count; ++k) {
             Box& box = blocks.boxes[k];
             if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
-            // Swept boxes: they also hold where the substep started (x - motion), so a particle that passed
-            // through a collider in one substep is still offered to it (continuous collision).
-            const Box motion = particle_bounds(state.motion, blocks.start[k], blocks.start[k + 1]);
-            if (!motion.empty()) {
-                box.lo = glm::min(box.lo, box.lo - motion.hi);
-                box.hi = glm::max(box.hi, box.hi - motion.lo);
-            }
+            box.lo -= reach;
+            box.hi += reach;
         }
         blocks.cloth = Box{};
         for (const Box& b : blocks.boxes) {

@@ -1,10 +1,12 @@
 // Scene files, --set overrides, the field table and pins: every bundled scene loads and runs, every bad
 // input is rejected with a message naming its source, line, field and allowed values, and nothing is
 // ever half-applied.
+#include "clothsim/overloaded.hpp"
 #include "clothsim/scene.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -710,4 +712,38 @@ TEST_CASE("scene file: an error message that quotes inf, nan or INT64_MIN in an 
     CHECK_THAT(parse_error("[forces]\ngravity = [0.0, -inf, 0.0]\n"), Contains("-inf"));
     CHECK_THAT(parse_error("[forces]\nwind = [nan, 0.0, 0.0]\n"), Contains("nan"));
     CHECK_THAT(parse_error("[cloth]\nsize = [-9223372036854775808, 1]\n"), Contains("cloth.size"));
+}
+
+TEST_CASE("scene clamp_to_range: every field typed far out of range is clamped with a note, and the scene saves and reopens") {
+    using namespace clothsim;
+    for (double typed : {1e9, -1e9, std::nan(""), 1e-30, -1e-30}) {
+        INFO("typed " << typed);
+        Scene scene = load_scene("flag");
+        int notes = 0;
+        for (const FieldInfo& f : scene_fields()) {
+            std::visit(Overloaded{
+                           [&](int* v) { *v = std::isnan(typed) ? 0 : static_cast<int>(std::clamp(typed, -2e9, 2e9)); },
+                           [&](float* v) { *v = static_cast<float>(typed); },
+                           [&](glm::vec2* v) { *v = glm::vec2(static_cast<float>(typed)); },
+                           [&](glm::vec3* v) { *v = glm::vec3(static_cast<float>(typed)); },
+                           [&](auto*) {},
+                       },
+                       f.ref(scene));
+            if (const auto note = clamp_to_range(scene, f)) {
+                ++notes;
+                CHECK_THAT(*note, Catch::Contains(std::string(f.name)) && Catch::Contains("allowed"));
+            }
+            CHECK_FALSE(clamp_to_range(scene, f).has_value());  // clamped values are allowed
+        }
+        if (!(std::abs(typed) < 1.0)) CHECK(notes > 10);  // huge or NaN: most fields refuse it
+        // The axes must not be parallel or zero (a rule across fields): give them back their directions.
+        scene.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+        scene.cloth.v_axis = {0.0f, -1.0f, 0.0f};
+        scene.cloth.rows = std::min(scene.cloth.rows, 64);
+        scene.cloth.cols = std::min(scene.cloth.cols, 64);
+        scene.pins.particles.clear();
+        REQUIRE_NOTHROW(validate(scene));
+        const Scene reopened = parse_scene(to_toml(scene), "saved.toml");
+        CHECK(reopened.settings == scene.settings);
+    }
 }

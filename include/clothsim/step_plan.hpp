@@ -58,5 +58,8 @@ struct StageStatus {
 };
 std::string_view state_name(StageState state);  // "runs", "fused", "skipped"
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings);
+// What the profile adds to a stage's note: for a collider that ran, "N of M blocks tested" (the broad
+// phase's work); otherwise the status's own note. One wording for the panel, the text report and the JSON.
+std::string profile_note(const StageStatus& status, const StepProfile& profile);
 
 }  // namespace clothsim

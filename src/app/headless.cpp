@@ -57,9 +57,7 @@ void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages,
         const std::size_t i = static_cast<std::size_t>(s.stage);
         if (s.runs()) {
             std::printf(" %s %.4f", std::string(stage_name(s.stage)).c_str(), steps > 0 ? p.ms[i] / double(steps) : 0.0);
-            if (const int c = collider_index(s.stage); c >= 0) {
-                std::printf(" (%lld of %lld blocks tested)", p.blocks_tested[c], p.blocks_offered[c]);
-            }
+            if (collider_index(s.stage) >= 0) std::printf(" (%s)", profile_note(s, p).c_str());
             std::printf(";");
         } else {
             std::string& list = s.state == StageState::Skipped ? skipped : fused;

@@ -262,15 +262,8 @@ void profile_section(const AppState& app) {
     float total = 0.0f;
     for (const StageStatus& s : describe(app.sim.plan(), app.sim.topology(), settings)) {
         const std::size_t i = static_cast<std::size_t>(s.stage);
-        std::string note = s.note;
-        if (const int c = collider_index(s.stage); c >= 0) {
-            if (s.runs() && frame.blocks_offered[c] > 0) {
-                note = std::to_string(frame.blocks_tested[c]) + " of " + std::to_string(frame.blocks_offered[c]) +
-                       " blocks tested";
-            }
-        }
         total += app.stats.times.stage_ms[i];
-        row(stage_name(s.stage), s.state, app.stats.times.stage_ms[i], note);
+        row(stage_name(s.stage), s.state, app.stats.times.stage_ms[i], profile_note(s, frame));
     }
     const bool moved = app.stats.cloth_uploaded;
     const StageState drawn = moved ? StageState::Runs : StageState::Skipped;

@@ -263,10 +263,14 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         const bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
         blocks.boxes.resize(count);
         // Swept boxes: grown by the cloth's largest motion per axis, they also hold where the substep started
-        // (x - motion), so a particle that passed through a collider in one substep is still offered to it
-        // (continuous collision). One bound for the cloth costs one vectorised pass, not one per block.
-        const Box motion = particle_bounds(state.motion, 0, state.size());
-        const glm::vec3 reach = motion.empty() ? glm::vec3(0.0f) : glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
+        // (x - motion), so a particle that passed through the sphere or the cube in one substep is still
+        // offered to it (continuous collision). One bound for the cloth costs one vectorised pass, not one
+        // per block; the ground (a half-space: nothing passes through it unseen) needs none.
+        glm::vec3 reach(0.0f);
+        if (colliders.sphere.enabled || colliders.cube.enabled) {
+            const Box motion = particle_bounds(state.motion, 0, state.size());
+            if (!motion.empty()) reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
+        }
         for (std::size_t k = 0; k < count; ++k) {
             Box& box = blocks.boxes[k];
             if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);

@@ -131,4 +131,11 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     return out;
 }
 
+std::string profile_note(const StageStatus& status, const StepProfile& profile) {
+    const int c = collider_index(status.stage);
+    if (c < 0 || !status.runs() || profile.blocks_offered[c] == 0) return status.note;
+    return std::to_string(profile.blocks_tested[c]) + " of " + std::to_string(profile.blocks_offered[c]) +
+           " blocks tested";
+}
+
 }  // namespace clothsim

@@ -219,8 +219,11 @@ TEST_CASE("user session: labels follow the scene, and two F12 presses in a secon
                                          "echo \"title before: $(xdotool getwindowname $wid)\"\n"
                                          "click 110 59\nclick 40 84\nat 900 400\nsettle\n"
                                          "echo \"title after: $(xdotool getwindowname $wid)\"\n"
-                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12; sleep 0.1\n"
-                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12\nsettle\nsettle\n"
+                                         // Each press waits for its file (up to 20 s under load); in most runs both land in one second.
+                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12\n"
+                                         "for _ in $(seq 200); do ls clothsim-*.png >/dev/null 2>&1 && break; sleep 0.1; done\n"
+                                         "xdotool keydown F12; sleep 0.1; xdotool keyup F12\n"
+                                         "for _ in $(seq 200); do [ $(ls clothsim-*.png | wc -l) -ge 2 ] && break; sleep 0.1; done\n"
                                          "echo \"screenshots: $(ls clothsim-*.png | wc -l)\"\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);

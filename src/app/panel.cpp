@@ -314,6 +314,17 @@ void message_area(AppState& app, float height) {
     if (ImGui::SmallButton("Clear messages")) app.messages.clear();
 }
 
+// A file path to type and the button that acts on it; returns true when the button was pressed.
+bool path_field(const char* id, std::string& path, const char* button, const char* tooltip) {
+    char text[512];
+    std::snprintf(text, sizeof text, "%s", path.c_str());
+    if (ImGui::InputText(id, text, sizeof text)) path = text;
+    ImGui::SameLine();
+    const bool pressed = ImGui::Button(button);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tooltip);
+    return pressed;
+}
+
 // Bundled scenes, open a file, play / step / reset, time scale, save.
 void scene_section(AppState& app, PanelRequests& requests) {
     const std::vector<std::string> names = bundled_scene_names();
@@ -328,12 +339,10 @@ void scene_section(AppState& app, PanelRequests& requests) {
         ImGui::EndCombo();
     }
     if (from_file && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", app.scene_source.c_str());
-    char open[512];
-    std::snprintf(open, sizeof open, "%s", app.open_path.c_str());
-    if (ImGui::InputText("##open", open, sizeof open)) app.open_path = open;
-    ImGui::SameLine();
-    if (ImGui::Button("Open file")) requests.load = app.open_path;
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("load a .toml scene file; a bad file is rejected and nothing changes");
+    if (path_field("##open", app.open_path, "Open file",
+                   "load a .toml scene file; a bad file is rejected and nothing changes")) {
+        requests.load = app.open_path;
+    }
     if (ImGui::Button(app.paused ? "Play (Space)" : "Pause (Space)")) app.paused = !app.paused;
     ImGui::SameLine();
     if (ImGui::Button("Step (S)")) {
@@ -345,12 +354,9 @@ void scene_section(AppState& app, PanelRequests& requests) {
     ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx",
                        ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
-    char save[512];
-    std::snprintf(save, sizeof save, "%s", app.save_path.c_str());
-    if (ImGui::InputText("##save", save, sizeof save)) app.save_path = save;
-    ImGui::SameLine();
-    if (ImGui::Button("Save scene as")) requests.save = app.save_path;
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the current settings as a scene file (atomically)");
+    if (path_field("##save", app.save_path, "Save scene as", "writes the current settings as a scene file (atomically)")) {
+        requests.save = app.save_path;
+    }
 }
 
 // The forces' fields, and the wind as strength and heading, as a user thinks of it (both edit forces.wind).

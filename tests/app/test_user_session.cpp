@@ -121,27 +121,22 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
     const Image expected = load_png(ref_dir / "curtain.png");
     REQUIRE(expected.width == kWidth);
 
-    SECTION("picked in the bundled-scene combo") {
-        const TempDir dir("session_open_combo");
-        // flag (24 x 36), paused; the combo at the top of the panel, curtain its first item.
+    // flag (24 x 36), paused, then curtain opened by the panel's `actions`: the 3D view must be the reference.
+    const auto open_curtain = [&](const std::string& name, const std::string& actions) {
+        const TempDir dir(name);
         const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
-                                             "click 110 59\nclick 40 84\nat 900 400\nsettle\nshot opened.png\nquit\n");
+                                             actions + "at 900 400\nsettle\nshot opened.png\nquit\n");
         CAPTURE_RUN(r);
         REQUIRE(r.code == 0);
         const Image opened = load_png(dir / "opened.png");
         REQUIRE(opened.width == kWidth);
         CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
+    };
+    SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its first item)") {
+        open_curtain("session_open_combo", "click 110 59\nclick 40 84\n");
     }
     SECTION("typed into the file field and opened with the Open file button") {
-        const TempDir dir("session_open_file");
-        const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused", "--view", view_flags},
-                                             "click 115 82\nkey ctrl+a\ntype '" + scene_path("curtain") +
-                                                 "'\nclick 270 82\nat 900 400\nsettle\nshot opened.png\nquit\n");
-        CAPTURE_RUN(r);
-        REQUIRE(r.code == 0);
-        const Image opened = load_png(dir / "opened.png");
-        REQUIRE(opened.width == kWidth);
-        CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
+        open_curtain("session_open_file", "click 115 82\nkey ctrl+a\ntype '" + scene_path("curtain") + "'\nclick 270 82\n");
     }
 }
 

@@ -31,6 +31,9 @@ public:
 // ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
 using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*,
                               SolverMethod*, Integrator*>;
+using ConstFieldRef = std::variant<const int*, const float*, const bool*, const glm::vec2*, const glm::vec3*,
+                                   const std::string*, const PinSpec*, const WindModel*, const SolverMethod*,
+                                   const Integrator*>;
 
 struct FieldInfo {
     std::string_view name;  // dotted name, as in the scene file and --set
@@ -39,6 +42,8 @@ struct FieldInfo {
     double max;
     std::string_view help;  // one line
     FieldRef (*ref)(Scene&);
+    // The field of a scene that is only read.
+    ConstFieldRef read(const Scene& scene) const;
 };
 
 std::span<const FieldInfo> scene_fields();

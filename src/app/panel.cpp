@@ -58,10 +58,10 @@ void tooltip(const FieldInfo& f) {
 
 // Copies one field's value from `from` into `to`.
 void copy_field(const FieldInfo& f, const Scene& from, Scene& to) {
-    Scene& source = const_cast<Scene&>(from);  // read only: the table hands out mutable references
-    std::visit([&](auto* dst) { std::visit([&](auto* src) {
-                   if constexpr (std::is_same_v<decltype(dst), decltype(src)>) *dst = *src;
-               }, f.ref(source)); },
+    std::visit([&](auto* dst) { std::visit([&](const auto* src) {
+                   if constexpr (std::is_same_v<std::remove_pointer_t<decltype(dst)>,
+                                                std::remove_const_t<std::remove_pointer_t<decltype(src)>>>) *dst = *src;
+               }, f.read(from)); },
                f.ref(to));
 }
 

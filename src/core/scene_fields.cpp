@@ -139,9 +139,13 @@ std::string describe_allowed(const FieldInfo& field) {
         field.ref(scratch));
 }
 
+ConstFieldRef FieldInfo::read(const Scene& scene) const {
+    // The table's accessors take a mutable scene (the panel and the loader write through them); reading
+    // through one changes nothing, and what comes back is const.
+    return std::visit([](auto* field) -> ConstFieldRef { return field; }, ref(const_cast<Scene&>(scene)));
+}
+
 std::string format_value(const Scene& scene, const FieldInfo& field) {
-    // The table hands out mutable references; reading through one here changes nothing.
-    Scene& s = const_cast<Scene&>(scene);
     // A TOML basic string: quotes, backslashes and control characters escaped (TOML 1.0, "String").
     auto quoted = [](std::string_view text) {
         std::string out = "\"";
@@ -162,13 +166,13 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
     };
     return std::visit(
         Overloaded{
-            [&](int* v) { return std::to_string(*v); },
-            [&](float* v) { return number(*v); },
-            [&](bool* v) { return std::string(*v ? "true" : "false"); },
-            [&](glm::vec2* v) { return cat("[", number(v->x), ", ", number(v->y), "]"); },
-            [&](glm::vec3* v) { return cat("[", number(v->x), ", ", number(v->y), ", ", number(v->z), "]"); },
-            [&](std::string* v) { return quoted(*v); },
-            [&](PinSpec* v) {
+            [&](const int* v) { return std::to_string(*v); },
+            [&](const float* v) { return number(*v); },
+            [&](const bool* v) { return std::string(*v ? "true" : "false"); },
+            [&](const glm::vec2* v) { return cat("[", number(v->x), ", ", number(v->y), "]"); },
+            [&](const glm::vec3* v) { return cat("[", number(v->x), ", ", number(v->y), ", ", number(v->z), "]"); },
+            [&](const std::string* v) { return quoted(*v); },
+            [&](const PinSpec* v) {
                 std::string preset = quoted(kPinPresetNames[static_cast<int>(v->preset)]);
                 if (v->particles.empty()) return preset;
                 std::string list;
@@ -177,13 +181,12 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
                 }
                 return cat("{ preset = ", preset, ", particles = [", list, "] }");
             },
-            [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
+            [&]<class Enum>(const Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
         },
-        field.ref(s));
+        field.read(scene));
 }
 
 void validate(const Scene& scene) {
-    Scene& s = const_cast<Scene&>(scene);  // read only, see format_value
     for (const FieldInfo& f : kFields) {
         auto fail = [&] {
             throw SceneError(std::string(f.name) + " = " + format_value(scene, f) + " is out of range; allowed: " +
@@ -195,13 +198,13 @@ void validate(const Scene& scene) {
             return std::isfinite(v) && v >= static_cast<float>(f.min) && v <= static_cast<float>(f.max);
         };
         std::visit(Overloaded{
-                       [&](int* v) { if (!in_range(*v)) fail(); },
-                       [&](float* v) { if (!in_float_range(*v)) fail(); },
-                       [&](glm::vec2* v) { if (!in_float_range(v->x) || !in_float_range(v->y)) fail(); },
-                       [&](glm::vec3* v) { if (!in_float_range(v->x) || !in_float_range(v->y) || !in_float_range(v->z)) fail(); },
-                       [&](auto*) {},
+                       [&](const int* v) { if (!in_range(*v)) fail(); },
+                       [&](const float* v) { if (!in_float_range(*v)) fail(); },
+                       [&](const glm::vec2* v) { if (!in_float_range(v->x) || !in_float_range(v->y)) fail(); },
+                       [&](const glm::vec3* v) { if (!in_float_range(v->x) || !in_float_range(v->y) || !in_float_range(v->z)) fail(); },
+                       [&](const auto*) {},
                    },
-                   f.ref(s));
+                   f.read(scene));
     }
     const ClothSettings& c = scene.cloth;
     if (static_cast<long long>(c.rows) * c.cols > kMaxParticles) {

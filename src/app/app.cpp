@@ -254,10 +254,12 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
 void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
     const std::vector<int> pressed_keys = std::move(keys.pressed);
     keys.pressed.clear();
-    if (ImGui::GetIO().WantCaptureKeyboard) return;
     auto pressed = [&](int key) {
         return std::find(pressed_keys.begin(), pressed_keys.end(), key) != pressed_keys.end();
     };
+    // F12 types nothing: it takes a screenshot even while a text field has the keyboard.
+    if (pressed(GLFW_KEY_F12)) requests.screenshot = true;
+    if (ImGui::GetIO().WantCaptureKeyboard) return;
     if (pressed(GLFW_KEY_SPACE)) app.paused = !app.paused;
     if (pressed(GLFW_KEY_S)) {
         app.paused = true;
@@ -268,7 +270,6 @@ void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
     if (pressed(GLFW_KEY_H)) app.show_panel = !app.show_panel;
     if (pressed(GLFW_KEY_F)) requests.frame_camera = true;
     if (pressed(GLFW_KEY_HOME)) requests.reset_camera = true;
-    if (pressed(GLFW_KEY_F12)) requests.screenshot = true;
     if (pressed(GLFW_KEY_ESCAPE)) requests.quit = true;
 }
 

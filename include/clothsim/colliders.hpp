@@ -7,6 +7,10 @@
 // al. 2007, Macklin et al. 2014): it is reduced by at most mu times the normal correction, and stops
 // when it is smaller (static friction). A particle resting on a plane is pushed
 // back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
+//
+// Continuous collision: a particle whose path over the substep (x - motion -> x) went through the sphere or
+// the box, though it ends outside (or inside, past the middle), is stopped where the path entered the
+// thickness shell, its inward motion removed. The ground is a half-space and needs no sweep.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"

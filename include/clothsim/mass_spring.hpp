@@ -2,7 +2,7 @@
 // Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD: Integrator in settings.hpp).
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
-// accumulate forces (springs, wind), integrate (gravity and damping inside), collide (sphere, cube,
+// accumulate forces (springs, wind, the user's grab), integrate (gravity and damping inside), collide (sphere, cube,
 // ground), limit strain and speed, and once per step see whether the cloth may sleep. Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
 // Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,
@@ -15,7 +15,7 @@
 // between, is its speed. Once every speed has stayed under sleep_speed for solver.sleep_time seconds (and no
 // particle's substep motion exceeded 100 x sleep_speed x substep, so a vibration cannot hide between
 // checks), the cloth falls asleep: its motion is set to zero and substeps only advance the clock. Any change
-// of the settings (a collider moved, wind, a slider), a pin set or moved (a grab), or set_particle() wakes
+// of the settings (a collider moved, wind, a slider), a pin set or moved, a grab, or set_particle() wakes
 // it, and it restarts from rest.
 #pragma once
 

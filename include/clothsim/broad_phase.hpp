@@ -29,10 +29,11 @@ struct Box {
 };
 
 // The box around particles [begin, end); NaN coordinates are left out (a NaN particle touches nothing).
-Box particle_bounds(const Vec3Array& position, std::size_t begin, std::size_t end);
+// Positions are double and boxes float: a bound is rounded to the nearest float, within the tests' margin.
+Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t end);
 
 // The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles.
-void row_block_bounds(const Vec3Array& position, std::size_t begin, std::size_t count, Box* out);
+void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out);
 
 // Block k holds particles [start[k], start[k + 1]). For a rows x cols grid (rows * cols == particles) the
 // blocks are runs of at most kBlockParticles along each row, in row order: row r's j-th run is block

@@ -37,10 +37,8 @@ void collide(State& state, const CubeCollider& cube, float thickness, std::size_
              std::size_t end = kAllParticles);
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
-// Every enabled collider, in the order sphere, cube, ground, testing every particle. For float and double
-// (the reference solution).
-template <class T>
-void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::size_t begin = 0,
+// Every enabled collider, in the order sphere, cube, ground, testing every particle (the reference solution).
+void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
 
 // The particles as blocks (broad_phase.hpp: block_starts), each block's box and the whole cloth's box.

@@ -64,7 +64,7 @@ public:
     // `steps` whole steps of settings().integration.dt, each made of `substeps` substeps.
     void run_steps(long long steps);
 
-    float substep_length() const;  // s: dt / substeps
+    double substep_length() const;  // s: dt / substeps
 
     const SimulationSettings& settings() const { return settings_; }
     // The one way to change the live settings: takes effect at the next substep. A change replans the stages
@@ -82,9 +82,10 @@ public:
     float rest_area() const { return rest_area_; }
 
     Particle particle(std::size_t i) const;
-    glm::vec3 position(std::size_t i) const { return state_.position.get(i); }
+    // Positions rounded to float, as the renderer and exports use them; state() has them in double.
+    glm::vec3 position(std::size_t i) const { return glm::vec3(state_.position.get(i)); }
     std::vector<glm::vec3> positions() const;
-    // Second-order velocity estimates at the current positions (m/s).
+    // Second-order velocity estimates at the current positions (m/s), rounded to float.
     std::vector<glm::vec3> velocities() const;
     Energy energy() const;
     glm::vec3 momentum() const;  // kg m/s, free particles
@@ -142,18 +143,20 @@ public:
 private:
     // Restarts Verlet from velocities at the current positions with substep h (used at construction and
     // when the substep length changes, so a new dt does not turn into a velocity jump).
-    void restart(const std::vector<glm::vec3>& velocity, float h);
+    void restart(const std::vector<glm::dvec3>& velocity, double h);
+    // velocities() in double, for restarts and the energy.
+    std::vector<glm::dvec3> velocities_in_double() const;
     void compute_forces(const State& state, Vec3Array& force) const;
     void add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const;
     void replan();
     // The stages of step(), in pipeline order.
-    void step_fast(float h, StepProfile* profile);
-    void step_textbook(float h, StepProfile* profile);
-    void step_velocity_integrator(Integrator integrator, float h);
+    void step_fast(double h, StepProfile* profile);
+    void step_textbook(double h, StepProfile* profile);
+    void step_velocity_integrator(Integrator integrator, double h);
     void collide(StepProfile* profile);
     void limit_strain();
-    void limit_speed(float h);
-    void check_sleep(float h);
+    void limit_speed(double h);
+    void check_sleep(double h);
     glm::vec3 grab_force(const State& state) const;
 
     // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
@@ -182,7 +185,7 @@ private:
     int last_iterations_ = 0;
     bool asleep_ = false;
     double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
-    Vec3Array sleep_reference_;  // m: positions at the last sleep check (empty: none since waking)
+    DVec3Array sleep_reference_;  // m: positions at the last sleep check (empty: none since waking)
     double sleep_reference_time_ = 0.0;
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;

@@ -12,6 +12,6 @@ namespace clothsim {
 
 // Resizes `normals` to the particle count. A particle in no triangle (a 1 x N chain) gets u x v of nothing:
 // (0, 1, 0), so the renderer never normalises a zero vector.
-void compute_vertex_normals(const Topology& topology, const Vec3Array& position, std::vector<glm::vec3>& normals);
+void compute_vertex_normals(const Topology& topology, const DVec3Array& position, std::vector<glm::vec3>& normals);
 
 }  // namespace clothsim

@@ -10,20 +10,20 @@
 namespace clothsim {
 namespace {
 
-// GCC does not vectorise a float min/max reduction without -ffinite-math-only, so the AVX2 loop is written
-// out. _mm256_min_ps(x, lo) returns lo when x is NaN, which leaves NaN coordinates out, as the scalar loop does.
-__attribute__((target("avx2"))) void bounds_avx2(const float* v, std::size_t n, float& lo, float& hi) {
-    __m256 l = _mm256_set1_ps(INFINITY), h = _mm256_set1_ps(-INFINITY);
+// GCC does not vectorise a min/max reduction without -ffinite-math-only, so the AVX2 loop is written out.
+// _mm256_min_pd(x, lo) returns lo when x is NaN, which leaves NaN coordinates out, as the scalar loop does.
+__attribute__((target("avx2"))) void bounds_avx2(const double* v, std::size_t n, double& lo, double& hi) {
+    __m256d l = _mm256_set1_pd(INFINITY), h = _mm256_set1_pd(-INFINITY);
     std::size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        const __m256 x = _mm256_loadu_ps(v + i);
-        l = _mm256_min_ps(x, l);
-        h = _mm256_max_ps(x, h);
+    for (; i + 4 <= n; i += 4) {
+        const __m256d x = _mm256_loadu_pd(v + i);
+        l = _mm256_min_pd(x, l);
+        h = _mm256_max_pd(x, h);
     }
-    alignas(32) float ls[8], hs[8];
-    _mm256_store_ps(ls, l);
-    _mm256_store_ps(hs, h);
-    for (int k = 0; k < 8; ++k) {
+    alignas(32) double ls[4], hs[4];
+    _mm256_store_pd(ls, l);
+    _mm256_store_pd(hs, h);
+    for (int k = 0; k < 4; ++k) {
         lo = std::min(lo, ls[k]);
         hi = std::max(hi, hs[k]);
     }
@@ -33,39 +33,41 @@ __attribute__((target("avx2"))) void bounds_avx2(const float* v, std::size_t n, 
     }
 }
 
-void bounds_generic(const float* v, std::size_t n, float& lo, float& hi) {
+void bounds_generic(const double* v, std::size_t n, double& lo, double& hi) {
     for (std::size_t i = 0; i < n; ++i) {
         lo = v[i] < lo ? v[i] : lo;
         hi = hi < v[i] ? v[i] : hi;
     }
 }
 
-__attribute__((target("avx2"))) inline float hmin(__m256 v) {
-    __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    m = _mm_min_ps(m, _mm_movehl_ps(m, m));
-    m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
-    return _mm_cvtss_f32(m);
+__attribute__((target("avx2"))) inline double hmin(__m256d v) {
+    __m128d m = _mm_min_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
+    m = _mm_min_sd(m, _mm_unpackhi_pd(m, m));
+    return _mm_cvtsd_f64(m);
 }
-__attribute__((target("avx2"))) inline float hmax(__m256 v) {
-    __m128 m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    m = _mm_max_ps(m, _mm_movehl_ps(m, m));
-    m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
-    return _mm_cvtss_f32(m);
+__attribute__((target("avx2"))) inline double hmax(__m256d v) {
+    __m128d m = _mm_max_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
+    m = _mm_max_sd(m, _mm_unpackhi_pd(m, m));
+    return _mm_cvtsd_f64(m);
 }
 
-// A whole row's blocks at once: full blocks of 16 are two vectors per axis and a shuffle reduction.
-__attribute__((target("avx2"))) void row_bounds_avx2(const Vec3Array& position, std::size_t begin, std::size_t count,
-                                                      Box* out) {
-    const float* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
+// A whole row's blocks at once: full blocks of 16 are four vectors per axis and a shuffle reduction.
+__attribute__((target("avx2"))) void row_bounds_avx2(const DVec3Array& position, std::size_t begin,
+                                                      std::size_t count, Box* out) {
+    const double* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
     std::size_t c = 0;
     for (; c + 16 <= count; c += 16, ++out) {
         for (int a = 0; a < 3; ++a) {
-            const __m256 v0 = _mm256_loadu_ps(axes[a] + c), v1 = _mm256_loadu_ps(axes[a] + c + 8);
-            // min(v0, min(v1, +inf)) style: _mm256_min_ps(x, y) returns y when x is NaN, so NaNs drop out.
-            const __m256 lo = _mm256_min_ps(v0, _mm256_min_ps(v1, _mm256_set1_ps(INFINITY)));
-            const __m256 hi = _mm256_max_ps(v0, _mm256_max_ps(v1, _mm256_set1_ps(-INFINITY)));
-            out->lo[a] = hmin(lo);
-            out->hi[a] = hmax(hi);
+            const double* v = axes[a] + c;
+            // _mm256_min_pd(x, y) returns y when x is NaN, so starting from +inf NaNs drop out.
+            __m256d lo = _mm256_set1_pd(INFINITY), hi = _mm256_set1_pd(-INFINITY);
+            for (int k = 0; k < 16; k += 4) {
+                const __m256d x = _mm256_loadu_pd(v + k);
+                lo = _mm256_min_pd(x, lo);
+                hi = _mm256_max_pd(x, hi);
+            }
+            out->lo[a] = static_cast<float>(hmin(lo));
+            out->hi[a] = static_cast<float>(hmax(hi));
         }
     }
     if (c < count) *out = particle_bounds(position, begin + c, begin + count);
@@ -82,16 +84,21 @@ float largest(glm::vec3 v) { return std::max({std::abs(v.x), std::abs(v.y), std:
 
 }  // namespace
 
-Box particle_bounds(const Vec3Array& position, std::size_t begin, std::size_t end) {
+Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t end) {
     Box box;
     if (end <= begin) return box;
     const std::size_t n = end - begin;
-    const float* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
-    for (int a = 0; a < 3; ++a) (kAvx2 ? bounds_avx2 : bounds_generic)(axes[a], n, box.lo[a], box.hi[a]);
+    const double* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
+    for (int a = 0; a < 3; ++a) {
+        double lo = INFINITY, hi = -INFINITY;
+        (kAvx2 ? bounds_avx2 : bounds_generic)(axes[a], n, lo, hi);
+        box.lo[a] = static_cast<float>(lo);
+        box.hi[a] = static_cast<float>(hi);
+    }
     return box;
 }
 
-void row_block_bounds(const Vec3Array& position, std::size_t begin, std::size_t count, Box* out) {
+void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out) {
     static_assert(kBlockParticles == 16, "row_bounds_avx2 reduces two vectors per block");
     if (kAvx2) {
         row_bounds_avx2(position, begin, count, out);

@@ -9,7 +9,7 @@
 namespace clothsim {
 namespace {
 
-Topology grid_topology(int rows, int cols, const Vec3Array& position) {
+Topology grid_topology(int rows, int cols, const DVec3Array& position) {
     Topology t;
     t.rows = rows;
     t.cols = cols;
@@ -18,7 +18,9 @@ Topology grid_topology(int rows, int cols, const Vec3Array& position) {
         if (!inside(r0, c0) || !inside(r1, c1)) return;
         const auto a = static_cast<std::uint32_t>(t.index(r0, c0));
         const auto b = static_cast<std::uint32_t>(t.index(r1, c1));
-        t.springs.push_back({a, b, glm::length(position.get(b) - position.get(a)), kind});
+        // The rest length in the spring kernels' arithmetic (float d, float length), so a spring at its start
+        // length exerts exactly no force.
+        t.springs.push_back({a, b, glm::length(glm::vec3(position.get(b) - position.get(a))), kind});
         ++t.spring_count_by_kind[static_cast<int>(kind)];
     };
     // Grouped by kind and direction: each group is a set of parallel springs (the layout a fast solver
@@ -89,17 +91,17 @@ MassSpring build_simulation(const Scene& scene) {
     state.position.resize(n);
     for (int r = 0; r < cloth.rows; ++r) {
         for (int c = 0; c < cloth.cols; ++c) {
-            state.position.set(static_cast<std::size_t>(r) * cloth.cols + c,
-                               cloth.origin + u * (du * static_cast<float>(c)) + v * (dv * static_cast<float>(r)));
+            const glm::vec3 p = cloth.origin + u * (du * static_cast<float>(c)) + v * (dv * static_cast<float>(r));
+            state.position.set(static_cast<std::size_t>(r) * cloth.cols + c, glm::dvec3(p));
         }
     }
-    const float particle_mass = cloth.mass / static_cast<float>(n);
+    const double particle_mass = static_cast<double>(cloth.mass) / static_cast<double>(n);
     state.mass.assign(n, particle_mass);
-    state.inverse_mass.assign(n, 1.0f / particle_mass);
+    state.inverse_mass.assign(n, 1.0 / particle_mass);
     state.pinned.assign(n, 0);
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {
         state.pinned[i] = 1;
-        state.inverse_mass[i] = 0.0f;
+        state.inverse_mass[i] = 0.0;
     }
     std::vector<glm::vec3> velocity(n, cloth.velocity);
     Topology topology = grid_topology(cloth.rows, cloth.cols, state.position);

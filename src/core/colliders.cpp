@@ -11,8 +11,8 @@
 namespace clothsim {
 namespace {
 
-// Where a particle touches a collider: the outward unit normal and how far to move along it. Templates on
-// the scalar: float for the simulation, double for the reference solution.
+// Where a particle touches a collider: the outward unit normal and how far to move along it. Written for a
+// scalar type T; the state is double (state.hpp).
 template <class T>
 struct Contact {
     glm::vec<3, T> normal{T(0), T(1), T(0)};
@@ -148,7 +148,7 @@ std::optional<SweptHit<T>> swept_hit(const GroundCollider&, glm::vec<3, T>, glm:
 // push plus a friction cut of at most friction x depth), or the way back to where a swept path entered. A NaN
 // position has NaN depth and is left alone (the guard reports it).
 template <class T, class Shape>
-T collide_shape(BasicState<T>& state, const Shape& shape, T friction, T thickness, std::size_t begin,
+T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::size_t begin,
                 std::size_t end) {
     using Vec = glm::vec<3, T>;
     T deepest = T(0);
@@ -206,7 +206,7 @@ void collide_blocks(State& state, const Shape& shape, float thickness, bool broa
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
         ++tested;
-        const float moved = collide_shape(state, shape, shape.friction, thickness, begin, end);
+        const float moved = static_cast<float>(collide_shape(state, shape, double(shape.friction), double(thickness), begin, end));
         if (moved > 0.0f && broad_phase) {
             // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
             // conservative for the next collider, and O(1).
@@ -238,8 +238,8 @@ float signed_distance(const CubeCollider& cube, glm::vec3 p) {
 
 float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
 
-template <class T>
-void collide_all(BasicState<T>& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
+void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
+    using T = double;
     end = std::min(end, state.size());
     const T thickness = colliders.thickness;
     if (colliders.sphere.enabled) collide_shape(state, colliders.sphere, T(colliders.sphere.friction), thickness, begin, end);
@@ -299,17 +299,14 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     }
 }
 
-template void collide_all<float>(State&, const ColliderSettings&, std::size_t, std::size_t);
-template void collide_all<double>(DState&, const ColliderSettings&, std::size_t, std::size_t);
-
 void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, sphere, sphere.friction, thickness, begin, std::min(end, state.size()));
+    collide_shape(state, sphere, double(sphere.friction), double(thickness), begin, std::min(end, state.size()));
 }
 void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, cube, cube.friction, thickness, begin, std::min(end, state.size()));
+    collide_shape(state, cube, double(cube.friction), double(thickness), begin, std::min(end, state.size()));
 }
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, ground, ground.friction, thickness, begin, std::min(end, state.size()));
+    collide_shape(state, ground, double(ground.friction), double(thickness), begin, std::min(end, state.size()));
 }
 
 

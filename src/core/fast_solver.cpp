@@ -36,18 +36,20 @@ int first_column(const Direction& d) { return std::max(0, -d.dc); }
 int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); }
 
 // Spring forces of one run of springs, F_a = s d with s = k (|d| - L0) / |d| (s = k for L0 = 0; no force
-// when the ends of a spring with L0 > 0 coincide). The arithmetic is the textbook solver's, operation for
+// when the ends of a spring with L0 > 0 coincide). Positions are double: d is their difference in double,
+// rounded once to float, and the rest is float arithmetic. It is the textbook solver's, operation for
 // operation ((dx dx + dy dy) + dz dz, sqrt, (k (len - L0)) / len; no fused multiply-add), so the two
-// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt and divide are
-// correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
+// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt, divide and the
+// conversion are correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
 //
 // Generic kernel: auto-vectorised for the baseline ISA.
-[[gnu::always_inline]] inline void spring_forces_generic(const float* __restrict x, const float* __restrict y,
-                                                       const float* __restrict z, const float* __restrict rest,
+[[gnu::always_inline]] inline void spring_forces_generic(const double* __restrict x, const double* __restrict y,
+                                                       const double* __restrict z, const float* __restrict rest,
                                                        int offset, int begin, int end, float k, float* __restrict fx,
                                                        float* __restrict fy, float* __restrict fz) {
     for (int i = begin; i < end; ++i) {
-        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
+        const float dx = static_cast<float>(x[i + offset] - x[i]), dy = static_cast<float>(y[i + offset] - y[i]),
+                    dz = static_cast<float>(z[i + offset] - z[i]);
         const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
         const float stretched = k * (length - rest[i]) / length;
         const float s = rest[i] == 0.0f ? k : (length > 1e-12f ? stretched : 0.0f);
@@ -57,16 +59,23 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
     }
 }
 
+// Eight differences p[i + offset] - p[i] in double, rounded to float.
+__attribute__((target("avx2,fma"))) inline __m256 difference8(const double* p, int i, int offset) {
+    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset), _mm256_loadu_pd(p + i)));
+    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset + 4), _mm256_loadu_pd(p + i + 4)));
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
+}
+
 // AVX2 kernel: the same operations eight springs at a time; the tail reuses the generic loop.
-__attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, const float* y, const float* z,
+__attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, const double* y, const double* z,
                                                              const float* rest, int offset, int begin, int end,
                                                              float k, float* fx, float* fy, float* fz) {
     const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
     int i = begin;
     for (; i + 8 <= end; i += 8) {
-        const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + i + offset), _mm256_loadu_ps(x + i));
-        const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + i + offset), _mm256_loadu_ps(y + i));
-        const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + i + offset), _mm256_loadu_ps(z + i));
+        const __m256 dx = difference8(x, i, offset);
+        const __m256 dy = difference8(y, i, offset);
+        const __m256 dz = difference8(z, i, offset);
         const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                         _mm256_mul_ps(dz, dz));
         const __m256 length = _mm256_sqrt_ps(r2);
@@ -158,7 +167,7 @@ int FastSolver::effective_threads(int requested) const {
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
-                      const Vec3Array* external, float h, std::vector<Box>* row_boxes) {
+                      const Vec3Array* external, double h, std::vector<Box>* row_boxes) {
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
     // Buffers and the block layout are set up again only when the block count changes.
@@ -272,13 +281,13 @@ template <bool Avx2, unsigned Mask>
 // first), in the textbook solver's order: direction by direction, the spring ending at the particle before
 // the one starting there, external force last. Then position Verlet for the row (gravity and damping
 // inside). A particle with inverse mass 0 is pinned and does not move. Every particle is read and written
-// once.
+// once. The force is a float sum; the acceleration and the update are double, as in integrate_verlet.
 template <unsigned Mask, bool Ext>
 [[gnu::always_inline]] inline void integrate_row(const float* __restrict f0, const float* __restrict f1,
                                                  const float* __restrict f2, const float* __restrict ext,
-                                                 float* __restrict x, float* __restrict m,
-                                                 const float* __restrict w, int cols, std::size_t stride,
-                                                 float g, float keep, float h2) {
+                                                 double* __restrict x, double* __restrict m,
+                                                 const double* __restrict w, int cols, std::size_t stride,
+                                                 double g, double keep, double h2) {
     // f0, f1, f2: component rows of spring rows q, q-1, q-2, each 6 directions apart by 3 * stride.
     const std::size_t D = 3 * stride;
     for (int c = 0; c < cols; ++c) {
@@ -296,8 +305,8 @@ template <unsigned Mask, bool Ext>
             f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
         }
         if constexpr (Ext) f += ext[c];
-        const float moved = m[c] * keep + (f * w[c] + g) * h2;
-        const float step = w[c] == 0.0f ? 0.0f : moved;  // a select, not a branch: the loop vectorises
+        const double moved = m[c] * keep + (static_cast<double>(f) * w[c] + g) * h2;
+        const double step = w[c] == 0.0 ? 0.0 : moved;  // a select, not a branch: the loop vectorises
         m[c] = step;
         x[c] += step;
     }
@@ -310,7 +319,7 @@ struct SweepInput {
     const std::vector<int>& boundary_slot;
     const SimulationSettings& settings;
     const Vec3Array* external;
-    float h;
+    double h;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
     float* window;
     const float* zeros;
@@ -341,10 +350,10 @@ template <bool Avx2, unsigned Mask>
         // Row r is complete: gather its forces and integrate it in place. No later spring row reads row r,
         // so the collision stage may move it after the sweep.
         const std::size_t i0 = static_cast<std::size_t>(r) * grid.cols;
-        float* position[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
-        float* motion[3] = {state.motion.x.data() + i0, state.motion.y.data() + i0, state.motion.z.data() + i0};
-        const float gravity[3] = {g.x, g.y, g.z};
-        const float* w = state.inverse_mass.data() + i0;
+        double* position[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
+        double* motion[3] = {state.motion.x.data() + i0, state.motion.y.data() + i0, state.motion.z.data() + i0};
+        const double gravity[3] = {g.x, g.y, g.z};
+        const double* w = state.inverse_mass.data() + i0;
         for (int comp = 0; comp < 3; ++comp) {
             const std::size_t at = comp * stride + kPad;
             if (in.external) {

@@ -39,7 +39,7 @@ public:
     // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
     // block_starts(rows x cols) after the update.
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
-              float h, std::vector<Box>* row_boxes);
+              double h, std::vector<Box>* row_boxes);
 
     // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
     // at least 8.
@@ -62,7 +62,7 @@ private:
         const SimulationSettings& settings;
         unsigned mask;
         const Vec3Array* external;
-        float h;
+        double h;
         Box* row_boxes;
     };
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,

@@ -9,14 +9,14 @@
 namespace clothsim {
 
 template <class T>
-void accumulate_spring_forces(const Topology& topology, const BasicVec3Array<T>& position,
-                              const SpringSettings& springs, BasicVec3Array<T>& force) {
+void accumulate_spring_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
+                              BasicVec3Array<T>& force) {
     using Vec = glm::vec<3, T>;
     const std::array<T, kSpringKindCount> k = {springs.structural, springs.shear, springs.bending};
     for (const Spring& s : topology.springs) {
         const T ks = k[static_cast<int>(s.kind)];
         if (ks == T(0)) continue;
-        const Vec d = position.get(s.b) - position.get(s.a);
+        const Vec d(position.get(s.b) - position.get(s.a));  // the exact difference, rounded once to T
         const T rest = s.rest_length;
         T scale;  // f_a = scale * d
         if (rest == T(0)) {
@@ -39,10 +39,11 @@ glm::vec3 wind_velocity(const ForceSettings& forces, double time) {
     return forces.wind * static_cast<float>(1.0 + forces.gust_strength * gust);
 }
 
-template <class T>
-void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state, const ForceSettings& forces,
-                            T rest_area, BasicVec3Array<T>& force) {
-    using Vec = glm::vec<3, T>;
+template <class F>
+void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
+                            double rest_area, BasicVec3Array<F>& force) {
+    using T = double;
+    using Vec = glm::dvec3;
     const Vec wind(wind_velocity(forces, state.time));
     const T drag = forces.drag;
     const T inv_h = state.substep > T(0) ? T(1) / state.substep : T(0);
@@ -51,7 +52,7 @@ void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state
         const T area = rest_area / static_cast<T>(state.size());
         for (std::size_t i = 0; i < state.size(); ++i) {
             const Vec rel = wind - velocity(i);
-            force.add(i, drag * area * glm::length(rel) * rel);
+            force.add(i, glm::vec<3, F>(drag * area * glm::length(rel) * rel));
         }
         return;
     }
@@ -64,26 +65,26 @@ void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state
         const Vec v = (velocity(t[0]) + velocity(t[1]) + velocity(t[2])) * (T(1) / T(3));
         const T wn = glm::dot(wind - v, n);
         const Vec f = (drag * T(0.5) * twice_area * wn * std::abs(wn) / T(3)) * n;
-        force.add(t[0], f);
-        force.add(t[1], f);
-        force.add(t[2], f);
+        const glm::vec<3, F> share(f);
+        force.add(t[0], share);
+        force.add(t[1], share);
+        force.add(t[2], share);
     }
 }
 
-template void accumulate_spring_forces<float>(const Topology&, const Vec3Array&, const SpringSettings&, Vec3Array&);
+template void accumulate_spring_forces<float>(const Topology&, const DVec3Array&, const SpringSettings&, Vec3Array&);
 template void accumulate_spring_forces<double>(const Topology&, const DVec3Array&, const SpringSettings&,
                                                DVec3Array&);
-template void accumulate_wind_forces<float>(const Topology&, const State&, const ForceSettings&, float, Vec3Array&);
-template void accumulate_wind_forces<double>(const Topology&, const DState&, const ForceSettings&, double,
+template void accumulate_wind_forces<float>(const Topology&, const State&, const ForceSettings&, double, Vec3Array&);
+template void accumulate_wind_forces<double>(const Topology&, const State&, const ForceSettings&, double,
                                              DVec3Array&);
 
-double spring_potential_energy(const Topology& topology, const Vec3Array& position,
+double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs) {
     double energy = 0.0;
     for (const Spring& s : topology.springs) {
         const double k = stiffness_of(springs, s.kind);
-        const glm::vec3 d = position.get(s.b) - position.get(s.a);
-        const double stretch = std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) - s.rest_length;
+        const double stretch = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
         energy += 0.5 * k * stretch * stretch;
     }
     return energy;

@@ -9,10 +9,11 @@ namespace clothsim {
 // Hooke springs, F_a = k (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
-// Instantiated for float (the simulation) and double (the reference solution).
-template <class T>
-void accumulate_spring_forces(const Topology& topology, const BasicVec3Array<T>& position,
-                              const SpringSettings& springs, BasicVec3Array<T>& force);
+// d is taken in double and rounded to the force type F; the rest is computed in F. Instantiated for float
+// (the simulation; the fast solver rounds operation for operation alike) and double (the reference).
+template <class F>
+void accumulate_spring_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
+                              BasicVec3Array<F>& force);
 
 // Air velocity at a time: the wind vector scaled by deterministic gusts (two incommensurate sines, so a
 // run is reproducible and still looks irregular).
@@ -21,13 +22,14 @@ glm::vec3 wind_velocity(const ForceSettings& forces, double time);
 // Aerodynamic pressure. Triangles model: each triangle of area A and unit normal n, moving with the mean
 // velocity v of its corners, feels F = drag * A * (w_rel . n) |w_rel . n| n with w_rel = w - v, shared
 // equally by its corners; a sheet edge-on to the wind feels nothing. Uniform model: every particle feels
-// drag * (A_total / N) * |w_rel| w_rel. Velocities are the first-order (x - x_prev) / h.
-template <class T>
-void accumulate_wind_forces(const Topology& topology, const BasicState<T>& state, const ForceSettings& forces,
-                            T rest_area, BasicVec3Array<T>& force);
+// drag * (A_total / N) * |w_rel| w_rel. Velocities are the first-order (x - x_prev) / h. Computed in double,
+// added in the force type F (float for the simulation, double for the reference).
+template <class F>
+void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
+                            double rest_area, BasicVec3Array<F>& force);
 
 // Elastic energy 0.5 k (|d| - L0)^2 summed over springs (J).
-double spring_potential_energy(const Topology& topology, const Vec3Array& position,
+double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs);
 
 // Spring stiffness for a kind (N/m).

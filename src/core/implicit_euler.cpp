@@ -13,13 +13,13 @@ namespace {
 // alpha = max(0, 1 - L0/|d|): Ks = k (n n^T + alpha (I - n n^T)); K adds Ks (u_b - u_a) on a, minus on b.
 // Clamping alpha at 0 drops the destabilising transverse term of compressed springs (Baraff & Witkin
 // 1998, section 5.2; Choi & Ko 2002), keeping -K positive semi-definite.
-void spring_jacobian_times(const Topology& topology, const Vec3Array& position, const SpringSettings& springs,
+void spring_jacobian_times(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
                            const Vec3Array& u, Vec3Array& out) {
     out.resize(u.size());
     for (const Spring& s : topology.springs) {
         const float k = stiffness_of(springs, s.kind);
         if (k == 0.0f) continue;
-        const glm::vec3 d = position.get(s.b) - position.get(s.a);
+        const glm::vec3 d(position.get(s.b) - position.get(s.a));
         const float length = glm::length(d);
         const glm::vec3 du = u.get(s.b) - u.get(s.a);
         glm::vec3 f;
@@ -48,15 +48,16 @@ double dot(const Vec3Array& a, const Vec3Array& b) {
 }  // namespace
 
 int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
-                        const SpringSettings& springs, float tolerance, float h) {
+                        const SpringSettings& springs, float tolerance, double substep) {
     const std::size_t n = state.size();
     const float c = dynamics.damping;
-    state.substep = h;
+    const float h = static_cast<float>(substep);  // the solve's arithmetic
+    state.substep = substep;
     Vec3Array force, v, kv;
     force.resize(n);
     dynamics.forces(state, force);
     v.resize(n);
-    for (std::size_t i = 0; i < n; ++i) v.set(i, state.motion.get(i) / h);
+    for (std::size_t i = 0; i < n; ++i) v.set(i, glm::vec3(state.motion.get(i) / substep));
     spring_jacobian_times(topology, state.position, springs, v, kv);
 
     // b = h (F + M g - c M v + h K v); pinned rows are zero (their dv is held at 0).
@@ -64,7 +65,7 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
     b.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) continue;
-        const float m = state.mass[i];
+        const float m = static_cast<float>(state.mass[i]);
         b.set(i, h * (force.get(i) + m * dynamics.gravity - c * m * v.get(i) + h * kv.get(i)));
     }
     // A u = (1 + h c) M u - h^2 K u, with pinned rows and columns filtered out.
@@ -74,7 +75,7 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
         out.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
             if (state.pinned[i]) continue;
-            out.set(i, (1.0f + h * c) * state.mass[i] * u.get(i) - (h * h) * ku.get(i));
+            out.set(i, (1.0f + h * c) * static_cast<float>(state.mass[i]) * u.get(i) - (h * h) * ku.get(i));
         }
     };
 
@@ -102,12 +103,13 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
         ++iterations;
     }
 
+    // v' h = v h + dv h, in double: the velocity change is small next to the velocity at small substeps.
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) {
-            state.motion.set(i, glm::vec3(0.0f));
+            state.motion.set(i, glm::dvec3(0.0));
             continue;
         }
-        const glm::vec3 moved = (v.get(i) + dv.get(i)) * h;
+        const glm::dvec3 moved = state.motion.get(i) + glm::dvec3(dv.get(i)) * substep;
         state.motion.set(i, moved);
         state.position.add(i, moved);
     }

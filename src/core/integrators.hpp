@@ -11,47 +11,50 @@
 
 namespace clothsim {
 
-// Forces (N) at a state: reads positions and, for wind, motion / substep as the velocity.
-template <class T>
-using BasicForceFunction = std::function<void(const BasicState<T>&, BasicVec3Array<T>&)>;
+// Forces (N) at a state: reads positions and, for wind, motion / substep as the velocity. F is the force
+// type: float for the simulation, double for the reference solution. The state is double either way.
+template <class F>
+using BasicForceFunction = std::function<void(const State&, BasicVec3Array<F>&)>;
 using ForceFunction = BasicForceFunction<float>;
 
 // What every integrator needs besides the state.
-template <class T>
+template <class F>
 struct BasicDynamics {
-    const BasicForceFunction<T>& forces;    // springs and wind
-    const BasicForceFunction<T>& external;  // wind only (XPBD treats springs as constraints)
+    const BasicForceFunction<F>& forces;    // springs and wind
+    const BasicForceFunction<F>& external;  // wind only (XPBD treats springs as constraints)
     glm::vec3 gravity;                      // m/s^2
     float damping;                          // 1/s: a = F/m + g - c v
 };
 using Dynamics = BasicDynamics<float>;
 
-// a = F/m + g - c v for free particles, 0 for pinned ones; v = motion / h. Float and double.
-template <class T>
-void accelerations(const BasicState<T>& state, const BasicVec3Array<T>& force, glm::vec3 gravity, float damping,
-                   BasicVec3Array<T>& out);
+// a = F/m + g - c v (in double) for free particles, 0 for pinned ones; v = motion / h.
+template <class F>
+void accelerations(const State& state, const BasicVec3Array<F>& force, glm::vec3 gravity, double damping,
+                   DVec3Array& out);
 
 // Semi-implicit Euler: v' = v + h a(x, v), x' = x + h v'. First order; symplectic without damping.
-void step_symplectic_euler(State& state, const Dynamics& dynamics, float h);
+void step_symplectic_euler(State& state, const Dynamics& dynamics, double h);
 
-// Classical Runge-Kutta on (x, v): four force evaluations, fourth order. Float, and double for the
-// reference solution.
-template <class T>
-void step_rk4(BasicState<T>& state, const BasicDynamics<T>& dynamics, T h);
+// Classical Runge-Kutta on (x, v): four force evaluations, fourth order. Float forces for the simulation,
+// double forces for the reference solution.
+template <class F>
+void step_rk4(State& state, const BasicDynamics<F>& dynamics, double h);
 
 // Backward Euler linearised once (Baraff & Witkin 1998):
 //   ((1 + h c) M - h^2 K) dv = h (F + M g - c M v + h K v),   v' = v + dv,   x' = x + h v'
 // with K the spring Jacobian, its transverse part clamped for compressed springs so the matrix stays
 // symmetric positive definite, solved by conjugate gradients to `tolerance` (relative residual). Pinned
 // particles are held by filtering their rows out of the solve. Returns the CG iterations used.
+// The linear solve is in float (it finds the velocity change); the state update adds it in double.
 int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
-                        const SpringSettings& springs, float tolerance, float h);
+                        const SpringSettings& springs, float tolerance, double h);
 
 // XPBD (Macklin et al. 2016) with one constraint iteration per substep ("Small Steps", Macklin et al.
 // 2019): predict with external accelerations (gravity, wind, damping), then project every spring
 // C = |x_b - x_a| - L0 once, in list order, with compliance 1/k; v = (x' - x) / h. Converges to the
-// spring model as the substep shrinks.
+// spring model as the substep shrinks. The projection is computed in double: its corrections are as small
+// as the substep's motion.
 void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
-               float h);
+               double h);
 
 }  // namespace clothsim

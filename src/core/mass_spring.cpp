@@ -50,8 +50,9 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     topology_.spring_count_by_kind = {};
     for (const Spring& s : topology_.springs) ++topology_.spring_count_by_kind[static_cast<int>(s.kind)];
     for (const auto& t : topology_.triangles) {
-        const glm::vec3 a = state_.position.get(t[0]);
-        rest_area_ += 0.5f * glm::length(glm::cross(state_.position.get(t[1]) - a, state_.position.get(t[2]) - a));
+        const glm::dvec3 a = state_.position.get(t[0]);
+        rest_area_ += static_cast<float>(
+            0.5 * glm::length(glm::cross(state_.position.get(t[1]) - a, state_.position.get(t[2]) - a)));
     }
     force_.resize(n);
     state_.motion.resize(n);
@@ -60,8 +61,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     }
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
     replan();
-    restart(initial_velocity.empty() ? std::vector<glm::vec3>(n, glm::vec3(0.0f)) : initial_velocity,
-            substep_length());
+    restart(std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()), substep_length());
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
 }
@@ -80,8 +80,8 @@ int MassSpring::solver_threads() const {
     return set_aside ? 1 : fast_.solver->effective_threads(settings_.solver.threads);
 }
 
-float MassSpring::substep_length() const {
-    return settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
+double MassSpring::substep_length() const {
+    return static_cast<double>(settings_.integration.dt) / settings_.integration.substeps;
 }
 
 void MassSpring::apply(const SimulationSettings& settings) {
@@ -101,7 +101,7 @@ void MassSpring::set_substeps(int substeps) {
 // The whole pipeline of one substep, in order. The stages come from the plan (step_plan.hpp), made when the
 // settings were applied; a stage the plan leaves out is not run, not even as a branch per particle.
 void MassSpring::step() {
-    const float h = substep_length();
+    const double h = substep_length();
     if (asleep_) {
         state_.time += h;
         ++profile_.slept_substeps;
@@ -110,7 +110,7 @@ void MassSpring::step() {
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
     blocks_.current = blocks_.boxes_current = false;  // positions move now: last substep's boxes are stale
     const Integrator integrator = settings_.integration.integrator;
-    if (h != state_.substep || integrator != state_.integrator) restart(velocities(), h);
+    if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
 
     switch (plan_.path) {
         case StepPath::Fast: step_fast(h, profile); break;
@@ -147,7 +147,7 @@ void MassSpring::step() {
 
 // Fast solver: wind first (it reads the positions before the fast solver moves them), then one fused sweep
 // over the rows that also leaves each row's box for the collision broad phase.
-void MassSpring::step_fast(float h, StepProfile* profile) {
+void MassSpring::step_fast(double h, StepProfile* profile) {
     const Vec3Array* external = nullptr;
     if (plan_.wind) {
         StageTimer timer(profile, Stage::Wind);
@@ -168,7 +168,7 @@ void MassSpring::step_fast(float h, StepProfile* profile) {
     blocks_.current = false;  // the cloth's box is the union, made by the collision stage
 }
 
-void MassSpring::step_textbook(float h, StepProfile* profile) {
+void MassSpring::step_textbook(double h, StepProfile* profile) {
     force_.resize(state_.size());
     if (plan_.any_springs()) {
         StageTimer timer(profile, Stage::Springs);
@@ -197,10 +197,10 @@ void MassSpring::replan() {
 void MassSpring::wake() {
     calm_seconds_ = 0.0;
     substeps_since_check_ = 0;
-    sleep_reference_ = Vec3Array{};  // the next check starts a new baseline
+    sleep_reference_ = DVec3Array{};  // the next check starts a new baseline
     if (!asleep_) return;
     asleep_ = false;
-    restart(std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f)), substep_length());
+    restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
 }
 
 // Once per step. A particle's speed is its displacement since the last check over the time between: a
@@ -208,8 +208,8 @@ void MassSpring::wake() {
 // few mm/s (measured on the hanging scene: 2.3 mm/s at rest) while the step-to-step drift of a cloth at rest
 // is far smaller. So a vibration the baseline could alias away cannot sleep either, no particle's substep
 // motion may exceed kSubstepFactor x sleep_speed. NaN never counts as calm.
-void MassSpring::check_sleep(float h) {
-    constexpr float kSubstepFactor = 100.0f;
+void MassSpring::check_sleep(double h) {
+    constexpr double kSubstepFactor = 100.0;
     const std::size_t n = state_.size();
     const double elapsed = state_.time - sleep_reference_time_;
     if (sleep_reference_.size() != n || !(elapsed > 0.0)) {
@@ -217,14 +217,14 @@ void MassSpring::check_sleep(float h) {
         sleep_reference_time_ = state_.time;
         return;
     }
-    const float step_limit = settings_.solver.sleep_speed * static_cast<float>(elapsed);
-    const float substep_limit = kSubstepFactor * settings_.solver.sleep_speed * h;
-    const float step2 = step_limit * step_limit, substep2 = substep_limit * substep_limit;
+    const double step_limit = settings_.solver.sleep_speed * elapsed;
+    const double substep_limit = kSubstepFactor * settings_.solver.sleep_speed * h;
+    const double step2 = step_limit * step_limit, substep2 = substep_limit * substep_limit;
     bool calm = true;
     for (std::size_t i = 0; i < n && calm; ++i) {
         if (state_.pinned[i]) continue;
-        const glm::vec3 d = state_.position.get(i) - sleep_reference_.get(i);
-        const glm::vec3 m = state_.motion.get(i);
+        const glm::dvec3 d = state_.position.get(i) - sleep_reference_.get(i);
+        const glm::dvec3 m = state_.motion.get(i);
         calm = glm::dot(d, d) < step2 && glm::dot(m, m) < substep2;  // false for NaN
     }
     calm_seconds_ = calm ? calm_seconds_ + elapsed : 0.0;
@@ -232,7 +232,7 @@ void MassSpring::check_sleep(float h) {
     sleep_reference_time_ = state_.time;
     if (calm && calm_seconds_ + 1e-9 >= settings_.solver.sleep_time) {
         asleep_ = true;
-        for (std::size_t i = 0; i < n; ++i) state_.motion.set(i, glm::vec3(0.0f));
+        for (std::size_t i = 0; i < n; ++i) state_.motion.set(i, glm::dvec3(0.0));
     }
 }
 
@@ -242,21 +242,21 @@ void MassSpring::check_sleep(float h) {
 // removed, shared by inverse mass so momentum is kept: a spring held at its limit stops stretching instead
 // of storing speed it cannot use. It changes the model where it acts (docs/STABILITY.md).
 void MassSpring::limit_strain() {
-    const float limit = settings_.springs.strain_limit;
+    const double limit = settings_.springs.strain_limit;
     for (const Spring& s : topology_.springs) {
         if (s.rest_length == 0.0f) continue;
-        const float wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
-        if (wa + wb == 0.0f) continue;
-        const glm::vec3 d = state_.position.get(s.b) - state_.position.get(s.a);
-        const float length = glm::length(d);
-        const float longest = (1.0f + limit) * s.rest_length;
+        const double wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
+        if (wa + wb == 0.0) continue;
+        const glm::dvec3 d = state_.position.get(s.b) - state_.position.get(s.a);
+        const double length = glm::length(d);
+        const double longest = (1.0 + limit) * s.rest_length;
         if (!(length > longest)) continue;
-        const glm::vec3 shorten = d * ((length - longest) / (length * (wa + wb)));
+        const glm::dvec3 shorten = d * ((length - longest) / (length * (wa + wb)));
         state_.position.add(s.a, wa * shorten);
         state_.position.add(s.b, -wb * shorten);
-        const glm::vec3 n = d / length;
-        const float apart = glm::dot(state_.motion.get(s.b) - state_.motion.get(s.a), n);
-        if (apart > 0.0f) {
+        const glm::dvec3 n = d / length;
+        const double apart = glm::dot(state_.motion.get(s.b) - state_.motion.get(s.a), n);
+        if (apart > 0.0) {
             state_.motion.add(s.a, (wa / (wa + wb)) * apart * n);
             state_.motion.add(s.b, -(wb / (wa + wb)) * apart * n);
         }
@@ -264,20 +264,20 @@ void MassSpring::limit_strain() {
 }
 
 // Any particle moving faster than max_speed is slowed to it, its substep's displacement shortened with it.
-void MassSpring::limit_speed(float h) {
-    const float longest_step = settings_.forces.max_speed * h;
+void MassSpring::limit_speed(double h) {
+    const double longest_step = settings_.forces.max_speed * h;
     for (std::size_t i = 0; i < state_.size(); ++i) {
-        const glm::vec3 m = state_.motion.get(i);
-        const float step = glm::length(m);
+        const glm::dvec3 m = state_.motion.get(i);
+        const double step = glm::length(m);
         if (!(step > longest_step)) continue;
-        const glm::vec3 clamped = m * (longest_step / step);
+        const glm::dvec3 clamped = m * (longest_step / step);
         state_.position.add(i, clamped - m);  // the substep moved the particle by m: move it by clamped
         state_.motion.set(i, clamped);
     }
 }
 
 // One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.
-void MassSpring::step_velocity_integrator(Integrator integrator, float h) {
+void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
@@ -323,7 +323,8 @@ void MassSpring::grab(std::size_t i, glm::vec3 target) {
         for (const Spring& s : topology_.springs) {
             if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s.kind) * s.rest_length;
         }
-        const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
+        const float floor =
+            10.0f * static_cast<float>(state_.mass[i]) * std::max(glm::length(settings_.forces.gravity), 9.81f);
         grab_ = Grab{i, target, std::max(0.5f * springs, floor)};
         grab_external_ = Vec3Array{};
         grab_external_.resize(state_.size());
@@ -343,15 +344,15 @@ glm::vec3 MassSpring::grab_force() const { return grab_ ? grab_force(state_) : g
 // F = k (target - x) - c v, k = m / (4 h^2), c = 2 sqrt(k m) (critical), |F| capped at force_limit.
 glm::vec3 MassSpring::grab_force(const State& state) const {
     const std::size_t i = grab_->particle;
-    const float h = substep_length();
-    const float m = state.mass[i];
-    const float k = 0.25f * m / (h * h);
-    const float c = 2.0f * std::sqrt(k * m);
-    const glm::vec3 velocity = state.motion.get(i) / (state.substep > 0.0f ? state.substep : h);
-    glm::vec3 f = k * (grab_->target - state.position.get(i)) - c * velocity;
-    const float length = glm::length(f);
-    if (!(length <= grab_->force_limit)) f *= length > 0.0f ? grab_->force_limit / length : 0.0f;
-    return f;
+    const double h = substep_length();
+    const double m = state.mass[i];
+    const double k = 0.25 * m / (h * h);
+    const double c = 2.0 * std::sqrt(k * m);
+    const glm::dvec3 velocity = state.motion.get(i) / (state.substep > 0.0 ? state.substep : h);
+    glm::dvec3 f = k * (glm::dvec3(grab_->target) - state.position.get(i)) - c * velocity;
+    const double length = glm::length(f);
+    if (!(length <= grab_->force_limit)) f *= length > 0.0 ? grab_->force_limit / length : 0.0;
+    return glm::vec3(f);
 }
 
 void MassSpring::run_steps(long long steps) {
@@ -360,7 +361,10 @@ void MassSpring::run_steps(long long steps) {
     }
 }
 
-void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
+void MassSpring::restart(const std::vector<glm::dvec3>& given, double h) {
+    // Rest where no velocity is given (an empty list).
+    const std::vector<glm::dvec3>& velocity =
+        given.empty() ? std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)) : given;
     const Integrator integrator = settings_.integration.integrator;
     state_.integrator = integrator;
     if (integrator == Integrator::Verlet) {
@@ -370,27 +374,32 @@ void MassSpring::restart(const std::vector<glm::vec3>& velocity, float h) {
     }
     // The velocity integrators keep motion = v h.
     for (std::size_t i = 0; i < state_.size(); ++i) {
-        state_.motion.set(i, state_.pinned[i] ? glm::vec3(0.0f) : velocity[i] * h);
+        state_.motion.set(i, state_.pinned[i] ? glm::dvec3(0.0) : velocity[i] * h);
     }
     state_.substep = h;
 }
 
 Particle MassSpring::particle(std::size_t i) const {
-    const glm::vec3 x = state_.position.get(i);
-    return {x, x - state_.motion.get(i), state_.mass[i], state_.pinned[i] != 0};
+    const glm::dvec3 x = state_.position.get(i);
+    return {glm::vec3(x), glm::vec3(x - state_.motion.get(i)), static_cast<float>(state_.mass[i]), state_.pinned[i] != 0};
 }
 
 std::vector<glm::vec3> MassSpring::positions() const {
     std::vector<glm::vec3> p(state_.size());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = state_.position.get(i);
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = glm::vec3(state_.position.get(i));
     return p;
 }
 
 std::vector<glm::vec3> MassSpring::velocities() const {
-    if (asleep_) return std::vector<glm::vec3>(state_.size(), glm::vec3(0.0f));
+    const std::vector<glm::dvec3> exact = velocities_in_double();
+    return std::vector<glm::vec3>(exact.begin(), exact.end());
+}
+
+std::vector<glm::dvec3> MassSpring::velocities_in_double() const {
+    if (asleep_) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
     if (state_.integrator != Integrator::Verlet) {
-        std::vector<glm::vec3> v(state_.size(), glm::vec3(0.0f));
-        if (state_.substep > 0.0f) {
+        std::vector<glm::dvec3> v(state_.size(), glm::dvec3(0.0));
+        if (state_.substep > 0.0) {
             for (std::size_t i = 0; i < v.size(); ++i) v[i] = state_.motion.get(i) / state_.substep;
         }
         return v;
@@ -402,23 +411,23 @@ std::vector<glm::vec3> MassSpring::velocities() const {
 
 Energy MassSpring::energy() const {
     Energy e;
-    const std::vector<glm::vec3> v = velocities();
+    const std::vector<glm::dvec3> v = velocities_in_double();
     const glm::dvec3 g(settings_.forces.gravity);
     for (std::size_t i = 0; i < state_.size(); ++i) {
         if (state_.pinned[i]) continue;
         const double m = state_.mass[i];
-        e.kinetic += 0.5 * m * glm::dot(glm::dvec3(v[i]), glm::dvec3(v[i]));
-        e.gravity_potential -= m * glm::dot(g, glm::dvec3(state_.position.get(i)));
+        e.kinetic += 0.5 * m * glm::dot(v[i], v[i]);
+        e.gravity_potential -= m * glm::dot(g, state_.position.get(i));
     }
     e.spring_potential = spring_potential_energy(topology_, state_.position, settings_.springs);
     return e;
 }
 
 glm::vec3 MassSpring::momentum() const {
-    const std::vector<glm::vec3> v = velocities();
+    const std::vector<glm::dvec3> v = velocities_in_double();
     glm::dvec3 p(0.0);
     for (std::size_t i = 0; i < state_.size(); ++i) {
-        if (!state_.pinned[i]) p += double(state_.mass[i]) * glm::dvec3(v[i]);
+        if (!state_.pinned[i]) p += state_.mass[i] * v[i];
     }
     return glm::vec3(p);
 }
@@ -439,24 +448,24 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? 1 : 0;
-    state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
-    if (pinned) state_.motion.set(i, glm::vec3(0.0f));
+    state_.inverse_mass[i] = pinned ? 0.0 : 1.0 / state_.mass[i];
+    if (pinned) state_.motion.set(i, glm::dvec3(0.0));
 }
 
 void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
     if (!state_.pinned.at(i)) return;
     wake();
     stamp_ = next_stamp();
-    state_.position.set(i, position);
-    state_.motion.set(i, glm::vec3(0.0f));
+    state_.position.set(i, glm::dvec3(position));
+    state_.motion.set(i, glm::dvec3(0.0));
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {
     wake();
     stamp_ = next_stamp();
-    std::vector<glm::vec3> v = velocities();
-    state_.position.set(i, position);
-    v.at(i) = state_.pinned[i] ? glm::vec3(0.0f) : velocity;
+    std::vector<glm::dvec3> v = velocities_in_double();
+    state_.position.set(i, glm::dvec3(position));
+    v.at(i) = state_.pinned[i] ? glm::dvec3(0.0) : glm::dvec3(velocity);
     restart(v, substep_length());
 }
 

@@ -4,11 +4,12 @@
 
 namespace clothsim {
 
-void compute_vertex_normals(const Topology& topology, const Vec3Array& position, std::vector<glm::vec3>& normals) {
+void compute_vertex_normals(const Topology& topology, const DVec3Array& position, std::vector<glm::vec3>& normals) {
     normals.assign(position.size(), glm::vec3(0.0f));
     for (const auto& t : topology.triangles) {
-        const glm::vec3 a = position.get(t[0]);
-        const glm::vec3 n = glm::cross(position.get(t[1]) - a, position.get(t[2]) - a);
+        // Edges in double, rounded to float: what is drawn needs no more.
+        const glm::dvec3 a = position.get(t[0]);
+        const glm::vec3 n = glm::cross(glm::vec3(position.get(t[1]) - a), glm::vec3(position.get(t[2]) - a));
         normals[t[0]] += n;
         normals[t[1]] += n;
         normals[t[2]] += n;

@@ -16,27 +16,21 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
     // Whole substeps that end exactly at `duration`.
     const long long steps = std::max(1LL, std::llround(duration / h));
     h = duration / static_cast<double>(steps);
-    // The float builder gives the topology and the start; the state is then carried in double.
+    // The builder gives the topology and the start; forces are then computed in double too.
     const MassSpring start = build_simulation(scene);
-    const State& f = start.state();
-    const std::size_t n = f.size();
-    DState state;
-    state.position.resize(n);
-    state.motion.resize(n);
-    state.mass.assign(f.mass.begin(), f.mass.end());
-    state.inverse_mass.assign(f.inverse_mass.begin(), f.inverse_mass.end());
-    state.pinned = f.pinned;
+    State state = start.state();
+    const std::size_t n = state.size();
+    state.integrator = Integrator::Rk4;
     state.substep = h;
     const glm::dvec3 velocity(scene.cloth.velocity);
     for (std::size_t i = 0; i < n; ++i) {
-        state.position.set(i, glm::dvec3(f.position.get(i)));
-        if (!state.pinned[i]) state.motion.set(i, velocity * h);
+        state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : velocity * h);
     }
     const SimulationSettings& settings = scene.settings;
     const Topology& topology = start.topology();
     const double rest_area = start.rest_area();
     const bool wind = settings.forces.wind != glm::vec3(0.0f) || settings.forces.wind_model == WindModel::Uniform;
-    const BasicForceFunction<double> forces = [&](const DState& s, DVec3Array& out) {
+    const BasicForceFunction<double> forces = [&](const State& s, DVec3Array& out) {
         out.resize(s.size());
         accumulate_spring_forces(topology, s.position, settings.springs, out);
         if (wind) {
@@ -74,7 +68,7 @@ ErrorNorms relative_error(const std::vector<glm::dvec3>& positions, const std::v
 
 ErrorNorms relative_error(const MassSpring& sim, const std::vector<glm::dvec3>& reference, double size) {
     std::vector<glm::dvec3> p(sim.particle_count());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = glm::dvec3(sim.position(i));
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim.state().position.get(i);
     return relative_error(p, reference, size);
 }
 

@@ -84,7 +84,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     if (wind_speed > 0.0 && f.drag > 0.0f && std::isfinite(lightest) && state.size() > 0) {
         double area = 0.0;
         for (const auto& t : topology.triangles) {
-            const glm::vec3 a = state.position.get(t[0]);
+            const glm::dvec3 a = state.position.get(t[0]);
             area += 0.5 * glm::length(glm::cross(state.position.get(t[1]) - a, state.position.get(t[2]) - a));
         }
         const double share = f.wind_model == WindModel::Uniform ? area / double(state.size())

@@ -2,48 +2,51 @@
 
 namespace clothsim {
 
-void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h) {
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h) {
     const auto [keep, h2] = verlet_coefficients(damping, h);
+    const glm::dvec3 g(gravity);
     const std::size_t n = state.size();
-    Vec3Array& x = state.position;
-    Vec3Array& motion = state.motion;
+    DVec3Array& x = state.position;
+    DVec3Array& motion = state.motion;
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) {
-            motion.set(i, glm::vec3(0.0f));
+            motion.set(i, glm::dvec3(0.0));
             continue;
         }
-        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
-        const glm::vec3 step = motion.get(i) * keep + a * h2;  // x' - x = (x - x_prev)(1 - d) + a h^2/(1 + ch/2)
+        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g;
+        const glm::dvec3 step = motion.get(i) * keep + a * h2;  // x' - x = (x - x_prev)(1 - d) + a h^2/(1 + ch/2)
         motion.set(i, step);
         x.add(i, step);
     }
     state.substep = h;
 }
 
-void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
-                  glm::vec3 gravity, float damping, float h) {
+void start_verlet(State& state, const std::vector<glm::dvec3>& velocity, const Vec3Array& force,
+                  glm::vec3 gravity, double damping, double h) {
+    const glm::dvec3 g(gravity);
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) {
-            state.motion.set(i, glm::vec3(0.0f));
+            state.motion.set(i, glm::dvec3(0.0));
             continue;
         }
-        const glm::vec3 v = velocity[i];
-        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity - damping * v;
-        state.motion.set(i, v * h - a * (0.5f * h * h));
+        const glm::dvec3 v = velocity[i];
+        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g - damping * v;
+        state.motion.set(i, v * h - a * (0.5 * h * h));
     }
     state.substep = h;
 }
 
-std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
-                                         float damping) {
-    const float h = state.substep;
-    std::vector<glm::vec3> v(state.size(), glm::vec3(0.0f));
-    if (!(h > 0.0f)) return v;
-    const float scale = 1.0f / (1.0f + 0.5f * damping * h);
+std::vector<glm::dvec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
+                                          double damping) {
+    const double h = state.substep;
+    std::vector<glm::dvec3> v(state.size(), glm::dvec3(0.0));
+    if (!(h > 0.0)) return v;
+    const double scale = 1.0 / (1.0 + 0.5 * damping * h);
+    const glm::dvec3 g(gravity);
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
-        const glm::vec3 a = force.get(i) * state.inverse_mass[i] + gravity;
-        v[i] = (state.motion.get(i) / h + a * (0.5f * h)) * scale;
+        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g;
+        v[i] = (state.motion.get(i) / h + a * (0.5 * h)) * scale;
     }
     return v;
 }

@@ -17,27 +17,29 @@
 
 namespace clothsim {
 
-// The per-substep constants of the update x' - x = (x - x_prev) keep + a h2, shared by every solver.
+// The per-substep constants of the update x' - x = (x - x_prev) keep + a h2, shared by every solver. In
+// double: at h = 1e-5 s and c = 0.2 1/s, d = 2e-6, which float would hold only to 1.5%.
 struct VerletCoefficients {
-    float keep;  // 1 - d, d = c h / (1 + c h/2)
-    float h2;    // h^2 / (1 + c h/2)
+    double keep;  // 1 - d, d = c h / (1 + c h/2)
+    double h2;    // h^2 / (1 + c h/2)
 };
-inline VerletCoefficients verlet_coefficients(float damping, float h) {
-    const float half_ch = 0.5f * damping * h;
-    return {1.0f - damping * h / (1.0f + half_ch), h * h / (1.0f + half_ch)};
+inline VerletCoefficients verlet_coefficients(double damping, double h) {
+    const double half_ch = 0.5 * damping * h;
+    return {1.0 - damping * h / (1.0 + half_ch), h * h / (1.0 + half_ch)};
 }
 
-// One substep of length h for every free particle; pinned particles stay where they are.
-void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, float damping, float h);
+// One substep of length h for every free particle; pinned particles stay where they are. The acceleration
+// F/m + g and the update are computed in double from the float force.
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h);
 
 // Second-order start: x - x_prev = v h - (a - c v) h^2 / 2, with a = F/m + g at x. Sets state.substep = h.
-void start_verlet(State& state, const std::vector<glm::vec3>& velocity, const Vec3Array& force,
-                  glm::vec3 gravity, float damping, float h);
+void start_verlet(State& state, const std::vector<glm::dvec3>& velocity, const Vec3Array& force,
+                  glm::vec3 gravity, double damping, double h);
 
 // Second-order velocity at the current positions, from the Taylor expansion of x_prev around x:
 //   v (1 + c h/2) = (x - x_prev) / h + a h / 2.
 // State keeps x - x_prev as `motion` (see state.hpp for why).
-std::vector<glm::vec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
-                                         float damping);
+std::vector<glm::dvec3> verlet_velocities(const State& state, const Vec3Array& force, glm::vec3 gravity,
+                                          double damping);
 
 }  // namespace clothsim

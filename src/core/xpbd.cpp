@@ -7,15 +7,16 @@
 namespace clothsim {
 
 void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
-               float h) {
+               double h) {
     const std::size_t n = state.size();
     state.substep = h;
     // External accelerations only (gravity, wind, damping): the springs are constraints here.
-    Vec3Array wind, a;
+    Vec3Array wind;
+    DVec3Array a;
     wind.resize(n);
     dynamics.external(state, wind);
     accelerations(state, wind, dynamics.gravity, dynamics.damping, a);
-    const Vec3Array start = state.position;
+    const DVec3Array start = state.position;
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) continue;
         state.position.add(i, state.motion.get(i) + a.get(i) * (h * h));  // x + h (v + h a)
@@ -23,19 +24,19 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     // One Gauss-Seidel pass over the springs; with lambda starting at 0 each substep,
     // d_lambda = -C / (w_a + w_b + 1 / (k h^2)).
     for (const Spring& s : topology.springs) {
-        const float k = stiffness_of(springs, s.kind);
-        if (k == 0.0f) continue;
-        const float wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
-        const glm::vec3 d = state.position.get(s.b) - state.position.get(s.a);
-        const float length = glm::length(d);
-        if (!(length > 1e-12f)) continue;
-        const glm::vec3 normal = d / length;
-        const float lambda = -(length - s.rest_length) / (wa + wb + 1.0f / (k * h * h));
+        const double k = stiffness_of(springs, s.kind);
+        if (k == 0.0) continue;
+        const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
+        const glm::dvec3 d = state.position.get(s.b) - state.position.get(s.a);
+        const double length = glm::length(d);
+        if (!(length > 1e-12)) continue;
+        const glm::dvec3 normal = d / length;
+        const double lambda = -(length - s.rest_length) / (wa + wb + 1.0 / (k * h * h));
         state.position.add(s.a, -wa * lambda * normal);
         state.position.add(s.b, wb * lambda * normal);
     }
     for (std::size_t i = 0; i < n; ++i) {
-        state.motion.set(i, state.pinned[i] ? glm::vec3(0.0f) : state.position.get(i) - start.get(i));
+        state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));
     }
 }
 

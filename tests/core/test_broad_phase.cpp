@@ -18,7 +18,7 @@ using namespace clothsim;
 namespace {
 
 // The box of the finite coordinates of particles [begin, end), the plain way.
-Box reference_bounds(const Vec3Array& p, std::size_t begin, std::size_t end) {
+Box reference_bounds(const DVec3Array& p, std::size_t begin, std::size_t end) {
     Box b;
     for (std::size_t i = begin; i < end; ++i) {
         const glm::vec3 q = p.get(i);
@@ -124,7 +124,7 @@ void check_coverage(const Tally& tally) {
 
 TEST_CASE("broad_phase particle_bounds is the box of the finite coordinates of its range", "[broad_phase]") {
     std::mt19937 rng(11);
-    Vec3Array p;
+    DVec3Array p;
     p.resize(21);  // past two AVX2 blocks of 8, with a tail
     for (std::size_t i = 0; i < p.size(); ++i) p.set(i, random_vec(rng, 5.0f));
     for (std::size_t i : {0u, 3u, 9u, 17u, 20u}) p.set(i, glm::vec3(NAN));  // in vector blocks and in the tail
@@ -176,7 +176,7 @@ TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles 
 
     // The boxes of one row's blocks are those particle_bounds gives, NaN particles included.
     std::mt19937 rng(4);
-    Vec3Array p;
+    DVec3Array p;
     p.resize(n);
     for (std::size_t i = 0; i < n; ++i) p.set(i, random_vec(rng, 3.0f));
     for (std::size_t i : {std::size_t{1}, std::size_t{cols + 20u}, n - 1}) p.set(i, glm::vec3(NAN));

@@ -134,7 +134,7 @@ TEST_CASE("cloth_builder vertex normals of a flat cloth are u x v; a folded one 
     t.rows = 2;
     t.cols = 3;
     t.triangles = {{0, 1, 3}, {1, 4, 3}, {1, 2, 4}, {2, 5, 4}};
-    Vec3Array p;
+    DVec3Array p;
     p.resize(6);
     p.set(0, {-1, 0, 0}), p.set(1, {0, 0, 0}), p.set(2, {0, -1, 0});
     p.set(3, {-1, 0, 1}), p.set(4, {0, 0, 1}), p.set(5, {0, -1, 1});

@@ -83,9 +83,9 @@ TEST_CASE("colliders push particles out along the shortest way", "[colliders]") 
     CHECK(st.position.get(1).x == Approx(0.51f));
     CHECK(st.position.get(1).y == 0.5f);
     CHECK(st.position.get(2).z == Approx(-0.51f));
-    CHECK(st.position.get(3) == glm::vec3(0.0f, 0.5f, 0.0f));
+    CHECK(st.position.get(3) == glm::dvec3(0.0, 0.5, 0.0));
     // The push moves the particle but gives it no velocity: a deep penetration must not launch it.
-    CHECK(st.motion.get(0) == glm::vec3(0.0f));
+    CHECK(st.motion.get(0) == glm::dvec3(0.0));
     // Inward motion is removed (inelastic), outward and tangential motion kept when frictionless.
     st.position.set(0, {0.1f, 0.95f, 0.0f});
     st.motion.set(0, {0.02f, -0.01f, 0.0f});

@@ -51,7 +51,7 @@ float fastest_free_speed(const MassSpring& sim) {
     float fastest = 0.0f;
     for (std::size_t i = 0; i < st.size(); ++i) {
         if (st.pinned[i]) continue;
-        fastest = std::max(fastest, glm::length(st.motion.get(i)) / st.substep);
+        fastest = std::max(fastest, static_cast<float>(glm::length(st.motion.get(i)) / st.substep));
     }
     return fastest;
 }

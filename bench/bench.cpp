@@ -5,6 +5,7 @@
 #include "textbook_aos.hpp"
 #include "skipping.hpp"
 #include "stability_sweep.hpp"
+#include "substep_sweep.hpp"
 #include "work_precision.hpp"
 
 #include "clothsim/normals.hpp"
@@ -103,6 +104,17 @@ int main(int argc, char** argv) {
     work_precision->add_option("--repeats", wp.repeats, "Timed repetitions (median)")->check(CLI::Range(1, 50));
     work_precision->add_option("--csv", wp.csv, "Write the sweep as CSV");
     work_precision->add_option("--plots", wp.plot_dir, "Write accuracy-SCENE.png here (needs --csv; gnuplot)");
+    bench::SubstepSweepOptions ss;
+    CLI::App* substep_sweep = app.add_subcommand(
+        "substep-sweep", "Error against substeps per 1/60 s step for every integrator (docs/ACCURACY.md)");
+    substep_sweep->add_option("--T", ss.durations, "Simulated seconds per run (whole 1/60 s steps)")
+        ->delimiter(',')
+        ->check(CLI::PositiveNumber);
+    substep_sweep->add_option("--max-substeps", ss.max_substeps, "Largest substeps per step (1, 2, 4, ... up to it)")
+        ->check(CLI::Range(1, kMaxSubsteps));
+    substep_sweep->add_option("--integrators", ss.integrators, "Integrators to sweep")->delimiter(',');
+    substep_sweep->add_option("--csv", ss.csv, "Write the sweep as CSV");
+    substep_sweep->add_option("--plots", ss.plot_dir, "Write accuracy-substeps.png here (needs --csv; gnuplot)");
     bench::StabilityOptions st;
     CLI::App* stability = app.add_subcommand(
         "stability", "Largest stable substep by bisection against the predicted one (docs/STABILITY.md)");
@@ -124,6 +136,7 @@ int main(int argc, char** argv) {
     }
     if (*work_precision) return bench::run_work_precision(wp);
     if (*stability) return bench::run_stability(st);
+    if (*substep_sweep) return bench::run_substep_sweep(ss);
     if (*skipping) return bench::run_skipping(sk);
 
     std::vector<Row> rows;

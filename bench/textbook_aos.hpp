@@ -24,7 +24,7 @@ public:
     explicit TextbookAos(const MassSpring& sim) : settings_(sim.settings()), springs_(sim.topology().springs) {
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
             const Particle p{sim.position(i), sim.particle(i).previous_position, glm::vec3(0.0f),
-                             static_cast<float>(sim.state().inverse_mass[i]), sim.particle(i).pinned};
+                             sim.state().inverse_mass[i], sim.particle(i).pinned};
             particles_.push_back(p);
         }
     }

@@ -60,16 +60,19 @@ struct Topology {
 // moves by g h^2 = 9e-9 m, under half a float ulp at 1.6 m (6e-8 m), and a float state loses it (the
 // cloth freezes), or rounds every substep's update the same way (the error grows with the substep count).
 // In double the update keeps 29 more bits: at 4096 substeps per 1/60 s step the relative rounding per
-// substep is 1e-16 and 2.5e5 of them cost 3e-11 (docs/ACCURACY.md has the measurements). Forces are
-// computed in float from double differences x_b - x_a, which keeps the spring kernels' speed.
+// substep is 1e-16 and 2.5e5 of them cost 3e-11 (docs/ACCURACY.md has the measurements). What does not
+// accumulate stays float, which keeps the spring kernels' speed: forces (from the positions rounded to
+// float), masses, and the substep's velocity change a h^2 (rounded once per substep, relative 6e-8, the
+// force's own precision) before it is added to the double motion.
 struct State {
     DVec3Array position;  // m
     // m: x - x_prev, the motion of the last substep. Position Verlet's previous positions are x - motion.
     // Keeping the difference instead of x_prev is the same scheme with less round-off: the difference
     // keeps full relative precision, while x_prev would lose the small per-step motion to x's rounding.
     DVec3Array motion;
-    std::vector<double> mass;          // kg (kept for pinned particles too, for energy and momentum)
-    std::vector<double> inverse_mass;  // 1/kg, 0 for pinned particles
+    // Parameters, not accumulators: float is exact enough and halves what the integration loops read.
+    std::vector<float> mass;          // kg (kept for pinned particles too, for energy and momentum)
+    std::vector<float> inverse_mass;  // 1/kg, 0 for pinned particles
     std::vector<std::uint8_t> pinned;
     double time = 0.0;     // s
     double substep = 0.0;  // s: the substep `motion` belongs to

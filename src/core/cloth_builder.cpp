@@ -95,13 +95,13 @@ MassSpring build_simulation(const Scene& scene) {
             state.position.set(static_cast<std::size_t>(r) * cloth.cols + c, glm::dvec3(p));
         }
     }
-    const double particle_mass = static_cast<double>(cloth.mass) / static_cast<double>(n);
+    const float particle_mass = cloth.mass / static_cast<float>(n);
     state.mass.assign(n, particle_mass);
-    state.inverse_mass.assign(n, 1.0 / particle_mass);
+    state.inverse_mass.assign(n, 1.0f / particle_mass);
     state.pinned.assign(n, 0);
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {
         state.pinned[i] = 1;
-        state.inverse_mass[i] = 0.0;
+        state.inverse_mass[i] = 0.0f;
     }
     std::vector<glm::vec3> velocity(n, cloth.velocity);
     Topology topology = grid_topology(cloth.rows, cloth.cols, state.position);

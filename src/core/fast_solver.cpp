@@ -36,20 +36,19 @@ int first_column(const Direction& d) { return std::max(0, -d.dc); }
 int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); }
 
 // Spring forces of one run of springs, F_a = s d with s = k (|d| - L0) / |d| (s = k for L0 = 0; no force
-// when the ends of a spring with L0 > 0 coincide). Positions are double: d is their difference in double,
-// rounded once to float, and the rest is float arithmetic. It is the textbook solver's, operation for
+// when the ends of a spring with L0 > 0 coincide). The positions read are the state's double positions
+// rounded to float (the sweep's float copy). The arithmetic is the textbook solver's, operation for
 // operation ((dx dx + dy dy) + dz dz, sqrt, (k (len - L0)) / len; no fused multiply-add), so the two
-// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt, divide and the
-// conversion are correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
+// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt and divide are
+// correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
 //
 // Generic kernel: auto-vectorised for the baseline ISA.
-[[gnu::always_inline]] inline void spring_forces_generic(const double* __restrict x, const double* __restrict y,
-                                                       const double* __restrict z, const float* __restrict rest,
+[[gnu::always_inline]] inline void spring_forces_generic(const float* __restrict x, const float* __restrict y,
+                                                       const float* __restrict z, const float* __restrict rest,
                                                        int offset, int begin, int end, float k, float* __restrict fx,
                                                        float* __restrict fy, float* __restrict fz) {
     for (int i = begin; i < end; ++i) {
-        const float dx = static_cast<float>(x[i + offset] - x[i]), dy = static_cast<float>(y[i + offset] - y[i]),
-                    dz = static_cast<float>(z[i + offset] - z[i]);
+        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
         const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
         const float stretched = k * (length - rest[i]) / length;
         const float s = rest[i] == 0.0f ? k : (length > 1e-12f ? stretched : 0.0f);
@@ -59,23 +58,16 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
     }
 }
 
-// Eight differences p[i + offset] - p[i] in double, rounded to float.
-__attribute__((target("avx2,fma"))) inline __m256 difference8(const double* p, int i, int offset) {
-    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset), _mm256_loadu_pd(p + i)));
-    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset + 4), _mm256_loadu_pd(p + i + 4)));
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
-}
-
 // AVX2 kernel: the same operations eight springs at a time; the tail reuses the generic loop.
-__attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, const double* y, const double* z,
+__attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, const float* y, const float* z,
                                                              const float* rest, int offset, int begin, int end,
                                                              float k, float* fx, float* fy, float* fz) {
     const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
     int i = begin;
     for (; i + 8 <= end; i += 8) {
-        const __m256 dx = difference8(x, i, offset);
-        const __m256 dy = difference8(y, i, offset);
-        const __m256 dz = difference8(z, i, offset);
+        const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + i + offset), _mm256_loadu_ps(x + i));
+        const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + i + offset), _mm256_loadu_ps(y + i));
+        const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + i + offset), _mm256_loadu_ps(z + i));
         const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                         _mm256_mul_ps(dz, dz));
         const __m256 length = _mm256_sqrt_ps(r2);
@@ -119,6 +111,7 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     if (t.rows < 1 || t.cols < 1) return std::nullopt;
     FastSolver solver(t.rows, t.cols);
     const std::size_t n = static_cast<std::size_t>(t.rows) * t.cols;
+    for (auto& c : solver.copy_) c.assign(n, 0.0f);
     // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
     // exactly one spring for the sweep to be the same model as the spring list.
     for (auto& r : solver.rest_) r.assign(n, NAN);
@@ -231,6 +224,7 @@ struct Grid {
     int rows, cols;
     const std::array<std::vector<float>, 6>& rest;
     const std::array<bool, 6>& present;
+    const std::array<float*, 3> copy;  // the float copy of the positions the spring rows read (x, y, z)
     std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
     // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
     std::size_t row_floats() const { return 18 * stride(); }
@@ -238,10 +232,25 @@ struct Grid {
 
 constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
 
+// Rows [begin, end) of the float copy from the state's double positions (rounded to nearest).
+[[gnu::always_inline]] inline void copy_rows_body(const Grid& grid, const State& state, int begin, int end) {
+    end = std::min(end, grid.rows);
+    if (begin >= end) return;
+    const std::size_t i0 = static_cast<std::size_t>(begin) * grid.cols;
+    const std::size_t n = static_cast<std::size_t>(end - begin) * grid.cols;
+    const double* from[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
+    for (int comp = 0; comp < 3; ++comp) {
+        const double* __restrict in = from[comp];
+        float* __restrict out = grid.copy[comp] + i0;
+        for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(in[i]);
+    }
+}
+
 // Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
+// Reads rows r, r + 1 and r + 2 of the float copy, which the caller has brought up to date.
 template <bool Avx2, unsigned Mask>
-[[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state,
-                                                   const SpringSettings& springs, int r, float* out) {
+[[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const SpringSettings& springs, int r,
+                                                   float* out) {
     const std::size_t stride = grid.stride();
     const float stiffness[3] = {springs.structural, springs.shear, springs.bending};
     for (int d = 0; d < 6; ++d) {
@@ -266,49 +275,72 @@ template <bool Avx2, unsigned Mask>
         const int offset = dir.dr * grid.cols + dir.dc;
         const float k = stiffness[static_cast<int>(dir.kind)];
         if constexpr (Avx2) {
-            spring_forces_avx2(state.position.x.data(), state.position.y.data(), state.position.z.data(),
-                               grid.rest[d].data(), offset, row_start + c0, row_start + c1, k, f + c0,
-                               f + stride + c0, f + 2 * stride + c0);
+            spring_forces_avx2(grid.copy[0], grid.copy[1], grid.copy[2], grid.rest[d].data(), offset,
+                               row_start + c0, row_start + c1, k, f + c0, f + stride + c0, f + 2 * stride + c0);
         } else {
-            spring_forces_generic(state.position.x.data(), state.position.y.data(), state.position.z.data(),
-                                  grid.rest[d].data(), offset, row_start + c0, row_start + c1, k, f + c0,
-                                  f + stride + c0, f + 2 * stride + c0);
+            spring_forces_generic(grid.copy[0], grid.copy[1], grid.copy[2], grid.rest[d].data(), offset,
+                                  row_start + c0, row_start + c1, k, f + c0, f + stride + c0, f + 2 * stride + c0);
         }
     }
 }
 
+template <unsigned Mask, bool Ext>
+[[gnu::always_inline]] inline float row_force(const float* __restrict f0, const float* __restrict f1,
+                                              const float* __restrict f2, const float* __restrict ext,
+                                              std::size_t D, int c) {
+    float f = 0.0f;
+    if constexpr (kind_runs(Mask, SpringKind::Structural)) {
+        f = (f - f0[c - 1]) + f0[c];                  // (0,+1)
+        f = (f - f1[D + c]) + f0[D + c];              // (+1,0)
+    }
+    if constexpr (kind_runs(Mask, SpringKind::Shear)) {
+        f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];  // (+1,+1)
+        f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];  // (+1,-1)
+    }
+    if constexpr (kind_runs(Mask, SpringKind::Bending)) {
+        f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];  // (0,+2)
+        f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
+    }
+    if constexpr (Ext) f += ext[c];
+    return f;
+}
+
+// Everything integrate_row reads and writes for one row, per component (x, y, z).
+struct RowData {
+    const float* f[3][3];  // spring rows q, q-1, q-2 (column 0) of each component
+    const float* ext[3];   // external force, or null
+    double* x[3];
+    double* m[3];
+    const float* w;
+    float g[3];
+};
+
 // Row q's force, gathered from the spring rows q, q-1 and q-2 (-F on a spring's second particle, +F on its
 // first), in the textbook solver's order: direction by direction, the spring ending at the particle before
 // the one starting there, external force last. Then position Verlet for the row (gravity and damping
-// inside). A particle with inverse mass 0 is pinned and does not move. Every particle is read and written
-// once. The force is a float sum; the acceleration and the update are double, as in integrate_verlet.
+// inside), one component at a time. The force and the substep's change (f w + g) h2 are float,
+// the motion and the position double, as in integrate_verlet. A pinned particle (inverse mass 0) has no
+// change and zero motion, so it does not move. Every particle is read and written once.
 template <unsigned Mask, bool Ext>
-[[gnu::always_inline]] inline void integrate_row(const float* __restrict f0, const float* __restrict f1,
-                                                 const float* __restrict f2, const float* __restrict ext,
-                                                 double* __restrict x, double* __restrict m,
-                                                 const double* __restrict w, int cols, std::size_t stride,
-                                                 double g, double keep, double h2) {
-    // f0, f1, f2: component rows of spring rows q, q-1, q-2, each 6 directions apart by 3 * stride.
-    const std::size_t D = 3 * stride;
-    for (int c = 0; c < cols; ++c) {
-        float f = 0.0f;
-        if constexpr (kind_runs(Mask, SpringKind::Structural)) {
-            f = (f - f0[c - 1]) + f0[c];                  // (0,+1)
-            f = (f - f1[D + c]) + f0[D + c];              // (+1,0)
+[[gnu::always_inline]] inline void integrate_row(const RowData& row, int cols, std::size_t stride, double keep,
+                                                 float h2) {
+    const std::size_t D = 3 * stride;  // component rows of one spring row are 6 directions apart by 3 * stride
+    const float* __restrict w = row.w;
+    for (int comp = 0; comp < 3; ++comp) {
+        const float* __restrict f0 = row.f[comp][0];
+        const float* __restrict f1 = row.f[comp][1];
+        const float* __restrict f2 = row.f[comp][2];
+        const float* __restrict ext = row.ext[comp];
+        double* __restrict x = row.x[comp];
+        double* __restrict m = row.m[comp];
+        const float g = row.g[comp];
+        for (int c = 0; c < cols; ++c) {
+            const float f = row_force<Mask, Ext>(f0, f1, f2, ext, D, c);
+            const float change = w[c] == 0.0f ? 0.0f : (f * w[c] + g) * h2;  // a select: the loop vectorises
+            const double step = m[c] * keep + static_cast<double>(change);
+            m[c] = step;
+            x[c] += step;
         }
-        if constexpr (kind_runs(Mask, SpringKind::Shear)) {
-            f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];  // (+1,+1)
-            f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];  // (+1,-1)
-        }
-        if constexpr (kind_runs(Mask, SpringKind::Bending)) {
-            f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];  // (0,+2)
-            f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
-        }
-        if constexpr (Ext) f += ext[c];
-        const double moved = m[c] * keep + (static_cast<double>(f) * w[c] + g) * h2;
-        const double step = w[c] == 0.0 ? 0.0 : moved;  // a select, not a branch: the loop vectorises
-        m[c] = step;
-        x[c] += step;
     }
 }
 
@@ -334,13 +366,20 @@ template <bool Avx2, unsigned Mask>
     const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
     const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
+    // Rows of the float copy brought up to date so far. Row q is copied just before the first spring row
+    // that reads it (q - 2, or the block's first) and is not written again until its own update, after the
+    // last spring row that reads it: the spring rows see the positions at the start of the substep, as the
+    // textbook solver does, whatever moved them since the last substep (collisions, pins, a rebuild).
+    int copied_end = std::max(begin - 2, 0);
     for (int r = std::max(begin - 2, 0); r < end; ++r) {
         const float* current;
         if (in.boundary_slot[r] >= 0) {
             current = in.boundary.data() + static_cast<std::size_t>(in.boundary_slot[r]) * row_floats;
         } else {
+            copy_rows_body(grid, state, std::max(copied_end, r), r + 3);
+            copied_end = r + 3;
             float* slot = in.window + static_cast<std::size_t>(r % 3) * row_floats;
-            spring_row_body<Avx2, Mask>(grid, state, in.settings.springs, r, slot);
+            spring_row_body<Avx2, Mask>(grid, in.settings.springs, r, slot);
             current = slot;
         }
         spring_rows[2] = spring_rows[1];
@@ -350,20 +389,20 @@ template <bool Avx2, unsigned Mask>
         // Row r is complete: gather its forces and integrate it in place. No later spring row reads row r,
         // so the collision stage may move it after the sweep.
         const std::size_t i0 = static_cast<std::size_t>(r) * grid.cols;
-        double* position[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
-        double* motion[3] = {state.motion.x.data() + i0, state.motion.y.data() + i0, state.motion.z.data() + i0};
-        const double gravity[3] = {g.x, g.y, g.z};
-        const double* w = state.inverse_mass.data() + i0;
+        RowData row{};
         for (int comp = 0; comp < 3; ++comp) {
             const std::size_t at = comp * stride + kPad;
-            if (in.external) {
-                const float* ext = (comp == 0 ? in.external->x : comp == 1 ? in.external->y : in.external->z).data() + i0;
-                integrate_row<Mask, true>(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, ext,
-                                          position[comp], motion[comp], w, grid.cols, stride, gravity[comp], keep, h2);
-            } else {
-                integrate_row<Mask, false>(spring_rows[0] + at, spring_rows[1] + at, spring_rows[2] + at, nullptr,
-                                           position[comp], motion[comp], w, grid.cols, stride, gravity[comp], keep, h2);
-            }
+            for (int k = 0; k < 3; ++k) row.f[comp][k] = spring_rows[k] + at;
+        }
+        row.x[0] = state.position.x.data() + i0, row.x[1] = state.position.y.data() + i0, row.x[2] = state.position.z.data() + i0;
+        row.m[0] = state.motion.x.data() + i0, row.m[1] = state.motion.y.data() + i0, row.m[2] = state.motion.z.data() + i0;
+        row.w = state.inverse_mass.data() + i0;
+        row.g[0] = g.x, row.g[1] = g.y, row.g[2] = g.z;
+        if (in.external) {
+            row.ext[0] = in.external->x.data() + i0, row.ext[1] = in.external->y.data() + i0, row.ext[2] = in.external->z.data() + i0;
+            integrate_row<Mask, true>(row, grid.cols, stride, keep, h2);
+        } else {
+            integrate_row<Mask, false>(row, grid.cols, stride, keep, h2);
         }
         // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
         if (in.row_boxes) {
@@ -374,13 +413,13 @@ template <bool Avx2, unsigned Mask>
 
 // One compiled sweep per spring-kind mask and instruction set, picked from a table at run time.
 template <unsigned Mask>
-__attribute__((target("avx2,fma"))) void spring_row_avx2(const Grid& grid, const State& state,
-                                                          const SpringSettings& springs, int r, float* out) {
-    spring_row_body<true, Mask>(grid, state, springs, r, out);
+__attribute__((target("avx2,fma"))) void spring_row_avx2(const Grid& grid, const SpringSettings& springs, int r,
+                                                          float* out) {
+    spring_row_body<true, Mask>(grid, springs, r, out);
 }
 template <unsigned Mask>
-void spring_row_generic(const Grid& grid, const State& state, const SpringSettings& springs, int r, float* out) {
-    spring_row_body<false, Mask>(grid, state, springs, r, out);
+void spring_row_generic(const Grid& grid, const SpringSettings& springs, int r, float* out) {
+    spring_row_body<false, Mask>(grid, springs, r, out);
 }
 template <unsigned Mask>
 __attribute__((target("avx2,fma"))) void sweep_avx2(const SweepInput& in, State& state, int begin, int end) {
@@ -391,7 +430,7 @@ void sweep_generic(const SweepInput& in, State& state, int begin, int end) {
     sweep_body<false, Mask>(in, state, begin, end);
 }
 
-using SpringRowFn = void (*)(const Grid&, const State&, const SpringSettings&, int, float*);
+using SpringRowFn = void (*)(const Grid&, const SpringSettings&, int, float*);
 using SweepFn = void (*)(const SweepInput&, State&, int, int);
 template <std::size_t... M>
 constexpr std::array<SpringRowFn, 8> spring_row_table(bool avx2, std::index_sequence<M...>) {
@@ -404,14 +443,15 @@ constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...
 
 }  // namespace
 
-void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
-    const Grid grid{rows_, cols_, rest_, present_};
-    spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
+void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) {
+    const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
+    copy_rows_body(grid, state, r, r + 3);
+    spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
-    const Grid grid{rows_, cols_, rest_, present_};
+    const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
     sweep_table(use_avx2(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);

@@ -67,12 +67,16 @@ private:
     };
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);
-    // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).
-    void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const;
+    // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols);
+    // brings rows r to r + 2 of the float copy up to date first.
+    void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out);
 
     int rows_, cols_;
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
+    // The positions rounded to float, what the spring kernels read: half the bytes of the double state and
+    // eight springs per AVX2 vector. Scratch of the sweep: each substep copies every row before reading it.
+    std::array<std::vector<float>, 3> copy_;
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

@@ -19,7 +19,7 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
     for (const Spring& s : topology.springs) {
         const float k = stiffness_of(springs, s.kind);
         if (k == 0.0f) continue;
-        const glm::vec3 d(position.get(s.b) - position.get(s.a));
+        const glm::vec3 d = glm::vec3(position.get(s.b)) - glm::vec3(position.get(s.a));
         const float length = glm::length(d);
         const glm::vec3 du = u.get(s.b) - u.get(s.a);
         glm::vec3 f;
@@ -65,7 +65,7 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
     b.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         if (state.pinned[i]) continue;
-        const float m = static_cast<float>(state.mass[i]);
+        const float m = state.mass[i];
         b.set(i, h * (force.get(i) + m * dynamics.gravity - c * m * v.get(i) + h * kv.get(i)));
     }
     // A u = (1 + h c) M u - h^2 K u, with pinned rows and columns filtered out.
@@ -75,7 +75,7 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
         out.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
             if (state.pinned[i]) continue;
-            out.set(i, (1.0f + h * c) * static_cast<float>(state.mass[i]) * u.get(i) - (h * h) * ku.get(i));
+            out.set(i, (1.0f + h * c) * state.mass[i] * u.get(i) - (h * h) * ku.get(i));
         }
     };
 

@@ -323,8 +323,7 @@ void MassSpring::grab(std::size_t i, glm::vec3 target) {
         for (const Spring& s : topology_.springs) {
             if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s.kind) * s.rest_length;
         }
-        const float floor =
-            10.0f * static_cast<float>(state_.mass[i]) * std::max(glm::length(settings_.forces.gravity), 9.81f);
+        const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
         grab_ = Grab{i, target, std::max(0.5f * springs, floor)};
         grab_external_ = Vec3Array{};
         grab_external_.resize(state_.size());
@@ -381,7 +380,7 @@ void MassSpring::restart(const std::vector<glm::dvec3>& given, double h) {
 
 Particle MassSpring::particle(std::size_t i) const {
     const glm::dvec3 x = state_.position.get(i);
-    return {glm::vec3(x), glm::vec3(x - state_.motion.get(i)), static_cast<float>(state_.mass[i]), state_.pinned[i] != 0};
+    return {glm::vec3(x), glm::vec3(x - state_.motion.get(i)), state_.mass[i], state_.pinned[i] != 0};
 }
 
 std::vector<glm::vec3> MassSpring::positions() const {
@@ -427,7 +426,7 @@ glm::vec3 MassSpring::momentum() const {
     const std::vector<glm::dvec3> v = velocities_in_double();
     glm::dvec3 p(0.0);
     for (std::size_t i = 0; i < state_.size(); ++i) {
-        if (!state_.pinned[i]) p += state_.mass[i] * v[i];
+        if (!state_.pinned[i]) p += double(state_.mass[i]) * v[i];
     }
     return glm::vec3(p);
 }
@@ -448,7 +447,7 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? 1 : 0;
-    state_.inverse_mass[i] = pinned ? 0.0 : 1.0 / state_.mass[i];
+    state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
 }
 

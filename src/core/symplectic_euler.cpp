@@ -11,7 +11,7 @@ void accelerations(const State& state, const BasicVec3Array<F>& force, glm::vec3
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
         const glm::dvec3 v = state.motion.get(i) * inv_h;
-        out.set(i, glm::dvec3(force.get(i)) * state.inverse_mass[i] + g - damping * v);
+        out.set(i, glm::dvec3(force.get(i)) * double(state.inverse_mass[i]) + g - damping * v);
     }
 }
 template void accelerations<float>(const State&, const Vec3Array&, glm::vec3, double, DVec3Array&);

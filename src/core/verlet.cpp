@@ -4,7 +4,6 @@ namespace clothsim {
 
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h) {
     const auto [keep, h2] = verlet_coefficients(damping, h);
-    const glm::dvec3 g(gravity);
     const std::size_t n = state.size();
     DVec3Array& x = state.position;
     DVec3Array& motion = state.motion;
@@ -13,8 +12,8 @@ void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, d
             motion.set(i, glm::dvec3(0.0));
             continue;
         }
-        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g;
-        const glm::dvec3 step = motion.get(i) * keep + a * h2;  // x' - x = (x - x_prev)(1 - d) + a h^2/(1 + ch/2)
+        const glm::vec3 change = (force.get(i) * state.inverse_mass[i] + gravity) * h2;
+        const glm::dvec3 step = motion.get(i) * keep + glm::dvec3(change);  // x' - x = (x - x_prev)(1 - d) + a h2
         motion.set(i, step);
         x.add(i, step);
     }
@@ -30,7 +29,7 @@ void start_verlet(State& state, const std::vector<glm::dvec3>& velocity, const V
             continue;
         }
         const glm::dvec3 v = velocity[i];
-        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g - damping * v;
+        const glm::dvec3 a = glm::dvec3(force.get(i)) * double(state.inverse_mass[i]) + g - damping * v;
         state.motion.set(i, v * h - a * (0.5 * h * h));
     }
     state.substep = h;
@@ -45,7 +44,7 @@ std::vector<glm::dvec3> verlet_velocities(const State& state, const Vec3Array& f
     const glm::dvec3 g(gravity);
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
-        const glm::dvec3 a = glm::dvec3(force.get(i)) * state.inverse_mass[i] + g;
+        const glm::dvec3 a = glm::dvec3(force.get(i)) * double(state.inverse_mass[i]) + g;
         v[i] = (state.motion.get(i) / h + a * (0.5 * h)) * scale;
     }
     return v;

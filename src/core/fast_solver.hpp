@@ -9,8 +9,11 @@
 //    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
 //    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it in place
 //    (position Verlet) and, while the row is still in L1, writes the boxes of its particle blocks for the
-//    collision broad phase. Every particle's data is read and written once. Collisions are not part of the
-//    sweep: the caller's collision stage runs after it (collide_stage in colliders.hpp).
+//    collision broad phase. Collisions are not part of the sweep: the caller's collision stage runs after
+//    it (collide_stage in colliders.hpp).
+//  - The state is double (state.hpp); the spring kernels read a float copy of the positions, which the
+//    sweep writes row by row just before the first spring row that reads it. Each particle's state is read
+//    twice (for the copy, and two rows later, still in L1, for the update) and written once.
 //  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
 //    two spring rows just above it; they are computed before a barrier into shared storage and both
 //    neighbouring threads use the stored values. Each particle's force is summed in the same order for

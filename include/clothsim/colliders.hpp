@@ -1,4 +1,5 @@
-// Collision with a sphere, an axis-aligned box and the ground plane.
+// Collision with a sphere, an axis-aligned box and the ground plane: the projection contact model
+// (colliders.contact = projection, the default; penalty_contact.hpp in src/core has the smooth force model).
 //
 // After integration every free particle closer than `thickness` to a collider surface is projected out
 // to that distance along the surface normal (the box: along the shortest way out). The contact is

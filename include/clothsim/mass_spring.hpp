@@ -2,8 +2,9 @@
 // Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD: Integrator in settings.hpp).
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
-// accumulate forces (springs, wind, the user's grab), integrate (gravity and damping inside), collide (sphere, cube,
-// ground), limit strain and speed, and once per step see whether the cloth may sleep. Which of these stages
+// accumulate forces (springs, wind, penalty contact, the user's grab), integrate (gravity and damping inside),
+// collide (the projection contact: sphere, cube, ground), limit strain and speed, and once per step see whether
+// the cloth may sleep. colliders.contact picks penalty contact (a force) or projection (a stage after). Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
 // Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,
 // damping, forces, colliders, dt, substeps), replans the stages and wakes the cloth at that point, and the
@@ -41,7 +42,8 @@ struct Energy {
     double kinetic = 0.0;            // J: sum of m v^2 / 2 with second-order velocities
     double spring_potential = 0.0;   // J: sum of k (|d| - L0)^2 / 2
     double gravity_potential = 0.0;  // J: -sum of m g . x over free particles
-    double potential() const { return spring_potential + gravity_potential; }
+    double contact_potential = 0.0;  // J: sum of k_c p^4 / (4 t^2) over contacts (penalty contact; else 0)
+    double potential() const { return spring_potential + gravity_potential + contact_potential; }
     double total() const { return kinetic + potential(); }
 };
 
@@ -147,7 +149,9 @@ private:
     // velocities() in double, for restarts and the energy.
     std::vector<glm::dvec3> velocities_in_double() const;
     void compute_forces(const State& state, Vec3Array& force) const;
-    void add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const;
+    // Wind and penalty contact, as the plan has them, summed on their own into `scratch` and then added to
+    // `force` (the fast solver adds them as one external force: both round alike); timed when `profile` is set.
+    void add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch, StepProfile* profile) const;
     void replan();
     // The stages of step(), in pipeline order.
     void step_fast(double h, StepProfile* profile);
@@ -180,7 +184,7 @@ private:
     bool profiling_ = true;
     CollisionBlocks blocks_;     // particle blocks and their boxes for the collision broad phase
     Vec3Array force_;            // N, scratch of the current substep
-    Vec3Array wind_;             // N, scratch: wind summed on its own before it is added
+    Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
     int last_iterations_ = 0;
     bool asleep_ = false;

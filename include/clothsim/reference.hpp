@@ -1,8 +1,10 @@
 // Reference solutions and error norms for the accuracy study (docs/ACCURACY.md).
 //
 // The reference is the same scene, run by the same physics code (springs, wind, gravity, damping,
-// collisions) in double precision with classical RK4, at a substep halved until halving it once more
-// changes the final positions by less than `tolerance` of the cloth size.
+// collisions: the projection after each substep, or penalty contact forces, as colliders.contact says) in
+// double precision with classical RK4, at a substep halved until halving it once more changes the final
+// positions by less than `tolerance` of the cloth size. Only a smooth model has such a limit: projection
+// contact's events and stick/slip switches change with the step (docs/ACCURACY.md).
 #pragma once
 
 #include "clothsim/mass_spring.hpp"

@@ -30,10 +30,10 @@ public:
 
 // ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
 using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*,
-                              SolverMethod*, Integrator*>;
+                              SolverMethod*, Integrator*, ContactModel*>;
 using ConstFieldRef = std::variant<const int*, const float*, const bool*, const glm::vec2*, const glm::vec3*,
                                    const std::string*, const PinSpec*, const WindModel*, const SolverMethod*,
-                                   const Integrator*>;
+                                   const Integrator*, const ContactModel*>;
 
 struct FieldInfo {
     std::string_view name;  // dotted name, as in the scene file and --set
@@ -58,12 +58,14 @@ std::span<const std::string_view> pin_preset_names();   // none, top-corners, to
 std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook
 std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd
+std::span<const std::string_view> contact_model_names(); // projection, penalty
 
 // The names of an enumeration field's values, by the field's type (the loader, the field table and the
 // panel treat every enumeration alike through these).
 inline std::span<const std::string_view> names_of(const WindModel*) { return wind_model_names(); }
 inline std::span<const std::string_view> names_of(const SolverMethod*) { return solver_method_names(); }
 inline std::span<const std::string_view> names_of(const Integrator*) { return integrator_names(); }
+inline std::span<const std::string_view> names_of(const ContactModel*) { return contact_model_names(); }
 
 // ---- Loading and overriding. All throw SceneError; on a throw the target scene is left unchanged. ----
 Scene parse_scene(std::string_view toml_text, std::string_view source_name);
@@ -72,7 +74,8 @@ Scene load_scene_file(const std::filesystem::path& path);
 Scene load_scene(std::string_view name_or_path);
 // `key=value`: value is TOML ("128", "[0, -9.81, 0]", "true", "\"x\"") or a bare word ("top-row").
 void apply_override(Scene& scene, std::string_view assignment);
-// Every field range, and the checks that span fields (axes, pins inside the grid, grid size).
+// Every field range, and the checks that span fields (axes, pins inside the grid, grid size, penalty contact
+// with a positive thickness).
 void validate(const Scene& scene);
 // The panel's way in, checked against the same table as the loader: clamps `field` of `scene` into its
 // allowed range (each component of a vector; a non-finite value goes to the nearest bound, NaN to the

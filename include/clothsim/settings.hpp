@@ -38,6 +38,14 @@ enum class WindModel {
     Uniform,    // isotropic drag toward the air velocity, the same for every particle
 };
 
+// How the colliders act on the cloth.
+enum class ContactModel {
+    Projection,  // after integration, particles are projected out, with Coulomb friction and continuous
+                 // collision (colliders.hpp): the default
+    Penalty,     // a smooth, conservative, frictionless force k_c p^3 / thickness^2 at depth p, part of the
+                 // forces the integrator sees (penalty_contact.hpp): gives the accuracy study a well-posed error
+};
+
 struct ClothSettings {
     int rows = 32;                           // particles along v_axis (count)
     int cols = 32;                           // particles along u_axis (count)
@@ -104,6 +112,8 @@ struct ColliderSettings {
     CubeCollider cube;
     GroundCollider ground;
     float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
+    ContactModel contact = ContactModel::Projection;
+    float contact_stiffness = 1000.0f;  // N/m: penalty contact's k_c (force k_c p^3 / thickness^2 at depth p)
     bool operator==(const ColliderSettings&) const = default;
 };
 

@@ -7,9 +7,13 @@
 // (docs/STABILITY.md derives both). The largest mode w_max is bounded two ways:
 //  - Gershgorin: w_max^2 <= max_i sum_j 2 k_ij / m_i over particle i's springs. Always safe.
 //  - Plane waves on a regular grid: w_max^2 <= 4 (k_struct + k_shear + k_bend) / m. Tighter.
+// Penalty contact (colliders.contact = penalty) adds its stiffness bound 3 k_c per enabled collider (its
+// stiffness 3 k_c p^2 / t^2 at depth p = t) to each particle's: to the Gershgorin row sum and, over the
+// lightest mass, to the plane-wave bound; implicit Euler and XPBD take it explicitly, so it gives them a limit.
 // Symplectic Euler has Verlet's limit; RK4's stability region reaches w h = 2 sqrt(2) on the imaginary axis
 // (and c h = 2.785 for damping); implicit Euler has no limit; XPBD's only one is its explicitly damped
-// prediction, c h < 2.
+// prediction, c h < 2. With penalty contact both get w_c h < 2 for the contact alone, w_c^2 = 3 k_c n / m
+// (n enabled colliders, m the lightest free particle).
 #pragma once
 
 #include "clothsim/mass_spring.hpp"

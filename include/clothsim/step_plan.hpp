@@ -3,7 +3,9 @@
 // MassSpring builds the plan when it is constructed and again whenever its settings change (it compares
 // them with the ones the plan was made for, once per substep), never per particle. A stage that would do
 // nothing is not run at all: a spring kind with stiffness 0 or no springs, zero wind, a disabled collider,
-// no strain or speed limit. The fast solver compiles one variant per set of spring kinds, so a skipped kind
+// no strain or speed limit. The contact model picks the colliders' stages: projection runs the sphere, cube
+// and ground stages after integration; penalty contact runs none of them and adds a force stage ("contact")
+// beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
 // costs no instruction in the hot loop (src/core/fast_solver.cpp). Gravity and damping are coefficients of
 // the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
 #pragma once
@@ -29,7 +31,8 @@ struct StepPlan {
     StepPath path = StepPath::Textbook;
     std::array<bool, kSpringKindCount> springs{};  // a kind runs: it has springs and a non-zero stiffness
     bool wind = false;
-    bool sphere = false, cube = false, ground = false;
+    bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)
+    bool sphere = false, cube = false, ground = false;  // the projection stages (colliders.contact = projection)
     bool strain_limit = false;
     bool speed_limit = false;
     bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth

@@ -15,10 +15,11 @@ namespace clothsim {
 enum class Stage {
     Springs,     // spring forces (textbook solver and velocity integrators)
     Wind,        // wind forces
+    Contact,     // penalty contact forces (colliders.contact = penalty; penalty_contact.hpp)
     Fast,        // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
     BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth
-    Sphere,      // sphere collisions (broad and narrow phase)
+    Sphere,      // sphere collisions (broad and narrow phase; projection contact)
     Cube,        // cube collisions
     Ground,      // ground collisions
     StrainLimit, // Provot's strain limit

@@ -33,7 +33,7 @@ constexpr SliderHint kHints[] = {
     {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
     {"integration.tolerance", 1e-10f, 1e-2f, true}, {"springs.strain_limit", 0.0f, 1.0f, false},
     {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
-    {"solver.sleep_time", 0.0f, 10.0f, false},
+    {"solver.sleep_time", 0.0f, 10.0f, false}, {"colliders.contact_stiffness", 10.0f, 1e6f, true},
 };
 
 const SliderHint* hint_for(std::string_view name) {
@@ -431,6 +431,13 @@ void colliders_section(Scene& edit, AppState& app) {
     ImGui::TextDisabled("ground");
     fields_section(edit, app, "colliders.ground.");
     fields_section(edit, app, "colliders.thickness");
+    ImGui::Separator();
+    ImGui::TextDisabled("contact model");
+    fields_section(edit, app, "colliders.contact");  // the model and its stiffness
+    const ColliderSettings& c = edit.settings.colliders;
+    if (c.contact == ContactModel::Penalty && !(c.thickness > 0.0f)) {
+        ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.3f, 1.0f), "penalty contact needs thickness > 0: no contact now");
+    }
 }
 
 void view_section(AppState& app, PanelRequests& requests) {

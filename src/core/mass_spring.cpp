@@ -4,6 +4,7 @@
 #include "forces.hpp"
 #include "fast_solver.hpp"
 #include "integrators.hpp"
+#include "penalty_contact.hpp"
 #include "verlet.hpp"
 
 #include <glm/common.hpp>
@@ -145,14 +146,20 @@ void MassSpring::step() {
     }
 }
 
-// Fast solver: wind first (it reads the positions before the fast solver moves them), then one fused sweep
-// over the rows that also leaves each row's box for the collision broad phase.
+// Fast solver: wind and penalty contact first (they read the positions before the fast solver moves them),
+// then one fused sweep over the rows that also leaves each row's box for the collision broad phase.
 void MassSpring::step_fast(double h, StepProfile* profile) {
     const Vec3Array* external = nullptr;
-    if (plan_.wind) {
-        StageTimer timer(profile, Stage::Wind);
+    if (plan_.wind || plan_.contact) {
         force_.resize(state_.size());
-        accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
+        if (plan_.wind) {
+            StageTimer timer(profile, Stage::Wind);
+            accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
+        }
+        if (plan_.contact) {
+            StageTimer timer(profile, Stage::Contact);
+            accumulate_contact_forces(state_, settings_.colliders, force_);
+        }
         if (grab_) force_.add(grab_->particle, grab_force(state_));
         external = &force_;
     } else if (grab_) {
@@ -174,10 +181,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Springs);
         accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
     }
-    if (plan_.wind) {
-        StageTimer timer(profile, Stage::Wind);
-        add_wind_forces(state_, force_, wind_);
-    }
+    if (plan_.wind || plan_.contact) add_external_forces(state_, force_, external_, profile);
     if (grab_) force_.add(grab_->particle, grab_force(state_));
     {
         StageTimer timer(profile, Stage::Integrate);
@@ -282,6 +286,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
         if (plan_.wind) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
+        if (plan_.contact) accumulate_contact_forces(s, settings_.colliders, f);
         if (grab_) f.add(grab_->particle, grab_force(s));
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
@@ -297,19 +302,27 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
     }
 }
 
-// Wind is summed on its own and added last, as the fast solver adds it, so both round alike.
-void MassSpring::add_wind_forces(const State& state, Vec3Array& force, Vec3Array& scratch) const {
+// Wind and contact are summed on their own and added last, as the fast solver adds them, so both round alike.
+void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch,
+                                     StepProfile* profile) const {
     scratch.resize(state.size());
-    accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, scratch);
+    if (plan_.wind) {
+        StageTimer timer(profile, Stage::Wind);
+        accumulate_wind_forces(topology_, state, settings_.forces, rest_area_, scratch);
+    }
+    if (plan_.contact) {
+        StageTimer timer(profile, Stage::Contact);
+        accumulate_contact_forces(state, settings_.colliders, scratch);
+    }
     for (std::size_t i = 0; i < state.size(); ++i) force.add(i, scratch.get(i));
 }
 
 void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
     force.resize(state.size());
     accumulate_spring_forces(topology_, state.position, settings_.springs, force);
-    if (wind_active(settings_.forces)) {
-        Vec3Array wind;
-        add_wind_forces(state, force, wind);
+    if (plan_.wind || plan_.contact) {
+        Vec3Array external;
+        add_external_forces(state, force, external, nullptr);
     }
     if (grab_) force.add(grab_->particle, grab_force(state));
 }
@@ -419,6 +432,7 @@ Energy MassSpring::energy() const {
         e.gravity_potential -= m * glm::dot(g, state_.position.get(i));
     }
     e.spring_potential = spring_potential_energy(topology_, state_.position, settings_.springs);
+    if (plan_.contact) e.contact_potential = contact_potential_energy(state_, settings_.colliders);
     return e;
 }
 

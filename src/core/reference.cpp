@@ -4,6 +4,7 @@
 #include "clothsim/scene.hpp"
 #include "forces.hpp"
 #include "integrators.hpp"
+#include "penalty_contact.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -29,21 +30,23 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
     const SimulationSettings& settings = scene.settings;
     const Topology& topology = start.topology();
     const double rest_area = start.rest_area();
-    const bool wind = settings.forces.wind != glm::vec3(0.0f) || settings.forces.wind_model == WindModel::Uniform;
+    // The stages the simulation runs, from its own plan: wind, penalty contact (a force) or projection.
+    const StepPlan& plan = start.plan();
     const BasicForceFunction<double> forces = [&](const State& s, DVec3Array& out) {
         out.resize(s.size());
         accumulate_spring_forces(topology, s.position, settings.springs, out);
-        if (wind) {
-            DVec3Array w;
-            w.resize(s.size());
-            accumulate_wind_forces(topology, s, settings.forces, rest_area, w);
-            for (std::size_t i = 0; i < s.size(); ++i) out.add(i, w.get(i));
+        if (plan.wind || plan.contact) {
+            DVec3Array external;
+            external.resize(s.size());
+            if (plan.wind) accumulate_wind_forces(topology, s, settings.forces, rest_area, external);
+            if (plan.contact) accumulate_contact_forces(s, settings.colliders, external);
+            for (std::size_t i = 0; i < s.size(); ++i) out.add(i, external.get(i));
         }
     };
     const BasicDynamics<double> dynamics{forces, forces, settings.forces.gravity, settings.springs.damping};
     for (long long s = 0; s < steps; ++s) {
         step_rk4(state, dynamics, h);
-        collide_all(state, settings.colliders);
+        if (plan.any_collider()) collide_all(state, settings.colliders);
         state.time += h;
     }
     std::vector<glm::dvec3> out(n);

@@ -60,6 +60,8 @@ const std::array kFields = {
     FieldInfo{"colliders.ground.height", "m", -kBig, kBig, "ground height", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.height; }},
     FieldInfo{"colliders.ground.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.friction; }},
     FieldInfo{"colliders.thickness", "m", 0, 1, "distance particles keep from every collider surface", [](Scene& s) -> FieldRef { return &s.settings.colliders.thickness; }},
+    FieldInfo{"colliders.contact", "", 0, 0, "projection: particles are moved out of the thickness shell after each substep, with Coulomb friction and continuous collision; penalty: a smooth force contact_stiffness x depth^3 / thickness^2 pushes them out (frictionless: friction is ignored; no continuous collision; thickness > 0)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact; }},
+    FieldInfo{"colliders.contact_stiffness", "N/m", 1, 1e9, "penalty contact's k_c: the push at depth = thickness is k_c x thickness (unused by projection)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact_stiffness; }},
 
     FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
     FieldInfo{"integration.substeps", "", 1, kMaxSubsteps, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
@@ -80,6 +82,7 @@ constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "unifo
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
 constexpr std::array<std::string_view, 5> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
                                                                "xpbd"};
+constexpr std::array<std::string_view, 2> kContactModelNames = {"projection", "penalty"};
 
 // Shortest text that reads back to the same float (std::to_chars), so 0.2f prints as 0.2, not 0.200000003.
 std::string number(double v) {
@@ -116,6 +119,7 @@ std::span<const std::string_view> pin_preset_names() { return kPinPresetNames; }
 std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
 std::span<const std::string_view> solver_method_names() { return kSolverMethodNames; }
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
+std::span<const std::string_view> contact_model_names() { return kContactModelNames; }
 
 std::string describe_allowed(const FieldInfo& field) {
     Scene scratch;
@@ -216,6 +220,12 @@ void validate(const Scene& scene) {
     if (!(lv > 1e-6f)) throw SceneError("cloth.v_axis = " + format_value(scene, *find_field("cloth.v_axis")) + " has no direction; allowed: a non-zero vector");
     if (glm::length(glm::cross(c.u_axis / lu, c.v_axis / lv)) < 1e-3f) {
         throw SceneError("cloth.u_axis and cloth.v_axis are parallel; allowed: two non-parallel directions");
+    }
+    const ColliderSettings& colliders = scene.settings.colliders;
+    if (colliders.contact == ContactModel::Penalty && !(colliders.thickness > 0.0f)) {
+        throw SceneError("colliders.thickness = " + format_value(scene, *find_field("colliders.thickness")) +
+                         " leaves penalty contact no shell to push in; allowed with colliders.contact = \"penalty\": "
+                         "a thickness in (0.0, 1.0] m");
     }
     for (const auto& [r, col] : scene.pins.particles) {
         if (r < 0 || r >= c.rows || col < 0 || col >= c.cols) {

@@ -1,6 +1,7 @@
 #include "clothsim/stability.hpp"
 
 #include "forces.hpp"
+#include "penalty_contact.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -40,18 +41,34 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     StabilityLimit limit;
     const Integrator integrator = settings.integration.integrator;
     const double c = settings.springs.damping;
+    // Penalty contact (penalty_contact.hpp): its stiffness at depth p is 3 k_c p^2 / t^2, bounded by its value
+    // at p = t, 3 k_c, per enabled collider. It acts on the particle alone (the collider does not move), a
+    // diagonal term of the stiffness matrix, so it adds to w^2 at most that bound over the particle's mass
+    // (Gershgorin for the row sum; Weyl's inequality for the plane-wave bound, which holds for any diagonal
+    // added to the springs'). The integrators that treat springs implicitly take contact explicitly, in their
+    // force (implicit Euler) or prediction (XPBD): symplectic Euler's limit w_c h < 2 on the contact alone.
+    const ColliderSettings& colliders = settings.colliders;
+    const bool penalty = colliders.contact == ContactModel::Penalty && colliders.thickness > 0.0f;
+    const double contact_k = penalty ? contact_stiffness_bound(colliders) : 0.0;
+    double lightest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        if (!state.pinned[i]) lightest = std::min(lightest, static_cast<double>(state.mass[i]));
+    }
+    const double contact_substep = contact_k > 0.0 && std::isfinite(lightest)
+                                       ? critical(std::sqrt(contact_k / lightest), c, 2.0, DampingForm::None)
+                                       : std::numeric_limits<double>::infinity();
     if (integrator == Integrator::ImplicitEuler) {
-        limit.unconditionally_stable = true;
-        limit.critical_substep = limit.plane_wave_substep = limit.wind_substep = std::numeric_limits<double>::infinity();
+        limit.unconditionally_stable = !std::isfinite(contact_substep);
+        limit.critical_substep = limit.plane_wave_substep = contact_substep;
+        limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
     if (integrator == Integrator::Xpbd) {
         // Springs are projected implicitly; the damping in XPBD's explicit prediction is forward Euler on a
         // decay rate c, stable while c h < 2.
-        limit.unconditionally_stable = !(c > 0.0);
-        limit.critical_substep = limit.plane_wave_substep = limit.unconditionally_stable
-                                                                ? std::numeric_limits<double>::infinity()
-                                                                : 2.0 / c;
+        const double damping_substep = c > 0.0 ? 2.0 / c : std::numeric_limits<double>::infinity();
+        limit.critical_substep = limit.plane_wave_substep = std::min(damping_substep, contact_substep);
+        limit.unconditionally_stable = !std::isfinite(limit.critical_substep);
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
@@ -61,16 +78,15 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         row_sum[s.a] += 2.0 * k;
         row_sum[s.b] += 2.0 * k;
     }
-    double gershgorin = 0.0, lightest = std::numeric_limits<double>::infinity();
+    double gershgorin = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
-        gershgorin = std::max(gershgorin, row_sum[i] / state.mass[i]);
-        lightest = std::min(lightest, static_cast<double>(state.mass[i]));
+        gershgorin = std::max(gershgorin, (row_sum[i] + contact_k) / state.mass[i]);
     }
     const SpringSettings& k = settings.springs;
     const double sum_k = double(k.structural) + double(k.shear) + double(k.bending);
     limit.omega_gershgorin = std::sqrt(gershgorin);
-    limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt(4.0 * sum_k / lightest) : 0.0;
+    limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest) : 0.0;
     const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
     const DampingForm form = integrator == Integrator::SymplecticEuler ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);

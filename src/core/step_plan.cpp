@@ -1,11 +1,15 @@
 #include "clothsim/step_plan.hpp"
 
+#include <initializer_list>
+#include <utility>
+
 namespace clothsim {
 
 std::string_view stage_name(Stage stage) {
     switch (stage) {
         case Stage::Springs: return "springs";
         case Stage::Wind: return "wind";
+        case Stage::Contact: return "contact";
         case Stage::Fast: return "fast solver";
         case Stage::Integrate: return "integrate";
         case Stage::BroadPhase: return "broad phase";
@@ -50,9 +54,15 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
         plan.springs[kind] = k[kind] != 0.0f && topology.spring_count_by_kind[kind] > 0;
     }
     plan.wind = wind_active(settings.forces);
-    plan.sphere = settings.colliders.sphere.enabled;
-    plan.cube = settings.colliders.cube.enabled;
-    plan.ground = settings.colliders.ground.enabled;
+    const ColliderSettings& c = settings.colliders;
+    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.ground.enabled;
+    if (c.contact == ContactModel::Penalty) {
+        plan.contact = any_enabled && c.thickness > 0.0f;  // no shell, no force (penalty_contact.hpp)
+    } else {
+        plan.sphere = c.sphere.enabled;
+        plan.cube = c.cube.enabled;
+        plan.ground = c.ground.enabled;
+    }
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
     plan.speed_limit = settings.forces.max_speed > 0.0f;
     plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
@@ -108,21 +118,41 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     } else {
         out.push_back({Stage::Wind, velocity ? Fused : Runs, velocity ? "in the integrate stage" : ""});
     }
+    const ColliderSettings& c = settings.colliders;
+    const bool penalty = c.contact == ContactModel::Penalty;
+    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.ground.enabled;
+    if (plan.contact) {
+        std::string which;
+        for (const auto& [on, name] : {std::pair{c.sphere.enabled, "sphere"}, std::pair{c.cube.enabled, "cube"},
+                                       std::pair{c.ground.enabled, "ground"}}) {
+            if (on) which.append(which.empty() ? "" : ", ").append(name);
+        }
+        out.push_back({Stage::Contact, velocity ? Fused : Runs,
+                       velocity ? "in the integrate stage: " + which : "penalty forces of " + which});
+    } else {
+        out.push_back({Stage::Contact, Skipped,
+                       !penalty ? "colliders.contact is projection"
+                                : (any_enabled ? "colliders.thickness is 0" : "no collider is enabled")});
+    }
     out.push_back({Stage::Fast, when(fast, Skipped),
                    fast ? "springs, gravity, damping and the Verlet update, row by row"
                         : (velocity ? "the integrator is not verlet" : "solver.method is textbook (or the cloth is no grid)")});
     out.push_back({Stage::Integrate, fast ? Fused : Runs, fast ? "in the fast solver" : ""});
+    const char* penalty_note = "colliders.contact is penalty (a force in the contact stage)";
     if (!plan.any_collider()) {
-        out.push_back({Stage::BroadPhase, Skipped, "no collider is enabled"});
+        out.push_back({Stage::BroadPhase, Skipped, penalty && any_enabled ? penalty_note : "no collider is enabled"});
     } else if (!settings.solver.broad_phase) {
         out.push_back({Stage::BroadPhase, Skipped, "solver.broad_phase is false"});
     } else {
         out.push_back({Stage::BroadPhase, Runs, fast ? "the cloth's box (the fast solver boxes the blocks)" : "boxes of the blocks and the cloth"});
     }
     const char* culled = settings.solver.broad_phase ? "blocks whose box meets it" : "every particle (broad phase off)";
-    out.push_back({Stage::Sphere, when(plan.sphere, Skipped), plan.sphere ? culled : "colliders.sphere.enabled is false"});
-    out.push_back({Stage::Cube, when(plan.cube, Skipped), plan.cube ? culled : "colliders.cube.enabled is false"});
-    out.push_back({Stage::Ground, when(plan.ground, Skipped), plan.ground ? culled : "colliders.ground.enabled is false"});
+    auto collider = [&](Stage stage, bool runs, bool enabled, const char* disabled) {
+        out.push_back({stage, when(runs, Skipped), runs ? culled : (enabled ? penalty_note : disabled)});
+    };
+    collider(Stage::Sphere, plan.sphere, c.sphere.enabled, "colliders.sphere.enabled is false");
+    collider(Stage::Cube, plan.cube, c.cube.enabled, "colliders.cube.enabled is false");
+    collider(Stage::Ground, plan.ground, c.ground.enabled, "colliders.ground.enabled is false");
     out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
     out.push_back({Stage::SpeedLimit, when(plan.speed_limit, Skipped), plan.speed_limit ? "" : "forces.max_speed is 0"});
     out.push_back({Stage::Sleep, when(plan.may_sleep, Skipped),

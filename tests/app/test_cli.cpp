@@ -144,7 +144,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 11);
+    CHECK(stage.size() == 12);
     // drape-sphere: fast solver, sphere and ground, no wind, no cube, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 38);
@@ -154,7 +154,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(stage.at("sphere").at("blocks_offered") == 30 * 38 * 120);  // 40 rows of 3 blocks
     CHECK(stage.at("sphere").at("blocks_tested").get<long long>() <= 30 * 38 * 120);
     CHECK(stage.at("ground").at("blocks_tested") == 0);  // the cloth is far above the ground
-    for (const char* skipped : {"wind", "cube", "strain limit", "speed limit"}) {
+    for (const char* skipped : {"wind", "contact", "cube", "strain limit", "speed limit"}) {
         INFO(skipped);
         CHECK(stage.at(skipped).at("state") == "skipped");
         CHECK(stage.at(skipped).at("ms") == 0.0);
@@ -163,9 +163,26 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     }
     CHECK_THAT(stage.at("wind").at("note").get<std::string>(), Contains("forces.wind"));
     CHECK_THAT(stage.at("cube").at("note").get<std::string>(), Contains("colliders.cube.enabled"));
+    CHECK_THAT(stage.at("contact").at("note").get<std::string>(), Contains("colliders.contact is projection"));
     double sum = 0.0;
     for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
     CHECK(p.at("total_ms").get<double>() == Approx(sum));
+
+    // Penalty contact: the contact force stage runs every substep, the projection stages do not.
+    const RunResult penalty = run_clothsim({"--headless", "--scene", "drape-sphere", "--steps", "10", "--set",
+                                            "colliders.contact=penalty", "--json"});
+    CAPTURE_RUN(penalty);
+    REQUIRE(penalty.code == 0);
+    const nlohmann::json penalty_profile = nlohmann::json::parse(penalty.out).at("profile");
+    std::map<std::string, nlohmann::json> with;
+    for (const auto& s : penalty_profile.at("stages")) with[s.at("stage").get<std::string>()] = s;
+    CHECK(with.at("contact").at("state") == "runs");
+    CHECK(with.at("contact").at("substeps_run") == 10 * 38);
+    for (const char* projection : {"sphere", "ground", "broad phase"}) {
+        INFO(projection);
+        CHECK(with.at(projection).at("state") == "skipped");
+        CHECK_THAT(with.at(projection).at("note").get<std::string>(), Contains("colliders.contact is penalty"));
+    }
 }
 
 TEST_CASE("cli: a headless run reports when the cloth slept, and bending 0 as a skipped spring kind") {

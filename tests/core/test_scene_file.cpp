@@ -747,3 +747,36 @@ TEST_CASE("scene clamp_to_range: every field typed far out of range is clamped w
         CHECK(reopened.settings == scene.settings);
     }
 }
+
+TEST_CASE("scene file: the contact model and its stiffness load, override, round-trip and reject bad values") {
+    using namespace clothsim;
+    const Scene s = parse_scene("[colliders]\ncontact = \"penalty\"\ncontact_stiffness = 2500.0\n", "test.toml");
+    CHECK(s.settings.colliders.contact == ContactModel::Penalty);
+    CHECK(s.settings.colliders.contact_stiffness == 2500.0f);
+    CHECK(Scene{}.settings.colliders.contact == ContactModel::Projection);  // the default: today's contact
+    const Scene reopened = parse_scene(to_toml(s), "saved.toml");
+    CHECK(reopened.settings == s.settings);
+    CHECK_THAT(to_toml(s), Contains("contact = \"penalty\"") && Contains("contact_stiffness = 2500.0"));
+
+    Scene o;
+    apply_override(o, "colliders.contact=penalty");
+    apply_override(o, "colliders.contact_stiffness=4e4");
+    CHECK(o.settings.colliders.contact == ContactModel::Penalty);
+    CHECK(o.settings.colliders.contact_stiffness == 4e4f);
+
+    const std::string model = parse_error("[colliders]\ncontact = \"springy\"\n");
+    CHECK_THAT(model, Contains("test.toml:2:") && Contains("colliders.contact") && Contains("springy") &&
+                          Contains("one of projection, penalty"));
+    const std::string stiffness = parse_error("[colliders]\ncontact_stiffness = 0.0\n");
+    CHECK_THAT(stiffness, Contains("test.toml:2:") && Contains("colliders.contact_stiffness") &&
+                              Contains("a number in [1.0, 1e+09] N/m"));
+    Scene unchanged = o;
+    CHECK_THAT(override_error(unchanged, "colliders.contact_stiffness=-5"),
+               Contains("colliders.contact_stiffness") && Contains(allowed("colliders.contact_stiffness")));
+    CHECK(unchanged.settings == o.settings);
+    // Penalty contact pushes inside the thickness shell: a thickness of 0 leaves it nothing to push in.
+    const std::string no_shell = parse_error("[colliders]\nthickness = 0.0\ncontact = \"penalty\"\n");
+    CHECK_THAT(no_shell, Contains("test.toml:2:") && Contains("colliders.thickness") && Contains("penalty"));
+    CHECK_THAT(override_error(unchanged, "colliders.thickness=0"), Contains("colliders.thickness"));
+    CHECK_NOTHROW(parse_scene("[colliders]\nthickness = 0.0\n", "test.toml"));  // projection allows it
+}

@@ -523,3 +523,51 @@ TEST_CASE("step_plan describe and the profile agree on which stages ran with a v
     sim.run_steps(2);
     check_describe_matches_profile(sim);
 }
+
+TEST_CASE("step_plan penalty contact runs the contact force stage instead of the projection stages", "[step_plan]") {
+    for (SolverMethod method : kMethods) {
+        INFO(method_name(method) << " solver");
+        Scene scene = load_scene("drape-sphere");
+        scene.cloth.rows = scene.cloth.cols = 12;
+        scene.settings.solver.method = method;
+        scene.settings.solver.sleep_speed = 0.0f;
+        scene.settings.colliders.contact = ContactModel::Penalty;
+        MassSpring sim = build_simulation(scene);
+        const StepPlan& plan = sim.plan();
+        CHECK(plan.contact);
+        CHECK_FALSE(plan.any_collider());  // no sphere, cube or ground projection
+        sim.run_steps(2);
+        const long long substeps = 2LL * scene.settings.integration.substeps;
+        CHECK(sim.profile().runs_of(Stage::Contact) == substeps);
+        for (Stage skipped : {Stage::Sphere, Stage::Cube, Stage::Ground, Stage::BroadPhase}) {
+            INFO("stage " << stage_name(skipped));
+            CHECK(sim.profile().runs_of(skipped) == 0);
+        }
+        check_describe_matches_profile(sim);
+        const std::vector<StageStatus> statuses = describe(sim.plan(), sim.topology(), sim.settings());
+        CHECK(status_of(statuses, Stage::Contact).note.find("sphere, ground") != std::string::npos);
+        CHECK(status_of(statuses, Stage::Sphere).note.find("colliders.contact is penalty") != std::string::npos);
+        CHECK(status_of(statuses, Stage::Cube).note.find("colliders.cube.enabled is false") != std::string::npos);
+
+        // Back to projection through the one call: the projection stages run again, the contact stage not.
+        test::edit_settings(sim, [](SimulationSettings& s) { s.colliders.contact = ContactModel::Projection; });
+        CHECK_FALSE(sim.plan().contact);
+        CHECK((sim.plan().sphere && sim.plan().ground));
+        const std::vector<StageStatus> back = describe(sim.plan(), sim.topology(), sim.settings());
+        CHECK(status_of(back, Stage::Contact).note == "colliders.contact is projection");
+    }
+    // A velocity integrator evaluates the contact inside its force calls; no thickness, no contact force.
+    Scene scene = load_scene("drape-sphere");
+    scene.cloth.rows = scene.cloth.cols = 12;
+    scene.settings.colliders.contact = ContactModel::Penalty;
+    scene.settings.integration.integrator = Integrator::Rk4;
+    MassSpring rk4 = build_simulation(scene);
+    rk4.run_steps(1);
+    CHECK(status_of(describe(rk4.plan(), rk4.topology(), rk4.settings()), Stage::Contact).state == StageState::Fused);
+    check_describe_matches_profile(rk4);
+    SimulationSettings flat = rk4.settings();
+    flat.colliders.thickness = 0.0f;
+    CHECK_FALSE(plan_step(rk4.topology(), flat, true).contact);
+    CHECK(status_of(describe(plan_step(rk4.topology(), flat, true), rk4.topology(), flat), Stage::Contact).note ==
+          "colliders.thickness is 0");
+}

@@ -1,0 +1,227 @@
+// Penalty contact (colliders.contact = penalty; src/core/penalty_contact.hpp): the force law against the
+// analytic rest depth, energy conservation through a bounce, the fast and textbook paths bit for bit, and
+// the stability bound that counts the contact stiffness.
+#include "penalty_contact.hpp"
+#include "support.hpp"
+
+#include "clothsim/stability.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+using namespace clothsim;
+
+namespace {
+
+constexpr double kThickness = 0.005;  // m
+constexpr double kStiffness = 1000.0;  // N/m
+constexpr double kMass = 0.01;         // kg
+
+// One free particle (a 1 x 1 cloth) at height y above the ground y = 0, with penalty contact and no sleep.
+Scene particle_over_ground(double y, float damping, Integrator integrator, SolverMethod method, int substeps) {
+    Scene s;
+    s.cloth.rows = s.cloth.cols = 1;
+    s.cloth.mass = static_cast<float>(kMass);
+    s.cloth.origin = {0.0f, static_cast<float>(y), 0.0f};
+    s.pins.preset = PinPreset::None;
+    s.settings.springs.damping = damping;
+    s.settings.colliders.contact = ContactModel::Penalty;
+    s.settings.colliders.contact_stiffness = static_cast<float>(kStiffness);
+    s.settings.colliders.thickness = static_cast<float>(kThickness);
+    s.settings.integration.integrator = integrator;
+    s.settings.integration.substeps = substeps;
+    s.settings.solver.method = method;
+    s.settings.solver.sleep_speed = 0.0f;
+    return s;
+}
+
+// m: how deep the particle is in the ground's shell (thickness minus height).
+double depth(const MassSpring& sim) { return double(sim.settings().colliders.thickness) - sim.state().position.y[0]; }
+
+bool bit_identical(const MassSpring& a, const MassSpring& b) {
+    const State& sa = a.state();
+    const State& sb = b.state();
+    const std::size_t bytes = sa.size() * sizeof(double);
+    return sa.size() == sb.size() && std::memcmp(sa.position.x.data(), sb.position.x.data(), bytes) == 0 &&
+           std::memcmp(sa.position.y.data(), sb.position.y.data(), bytes) == 0 &&
+           std::memcmp(sa.position.z.data(), sb.position.z.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.x.data(), sb.motion.x.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.y.data(), sb.motion.y.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.z.data(), sb.motion.z.data(), bytes) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("penalty contact force and potential follow k p^3 / t^2 and k p^4 / (4 t^2)", "[contact_penalty]") {
+    ColliderSettings colliders;
+    colliders.contact = ContactModel::Penalty;
+    colliders.contact_stiffness = static_cast<float>(kStiffness);
+    colliders.thickness = static_cast<float>(kThickness);
+    const double t = colliders.thickness;  // the float setting, in double
+    const double p = 0.002;                 // m into the ground's shell
+    State state = test::free_particles({{0.3f, 0.0f, 0.0f}}, static_cast<float>(kMass));
+    state.position.set(0, {0.3, t - p, 0.0});
+    DVec3Array force;
+    force.resize(1);
+    accumulate_contact_forces(state, colliders, force);
+    const double expected = kStiffness * p * p * p / (t * t);
+    CHECK(force.get(0).y == Approx(expected).epsilon(1e-12));
+    CHECK(force.get(0).x == 0.0);
+    CHECK(contact_potential_energy(state, colliders) == Approx(kStiffness * p * p * p * p / (4.0 * t * t)).epsilon(1e-12));
+    // Outside the shell: no force, no energy; a pinned particle feels nothing.
+    state.position.set(0, {0.3, t + 1e-6, 0.0});
+    force.resize(1);
+    accumulate_contact_forces(state, colliders, force);
+    CHECK(force.get(0) == glm::dvec3(0.0));
+    CHECK(contact_potential_energy(state, colliders) == 0.0);
+    state.position.set(0, {0.3, 0.0, 0.0});
+    state.pinned[0] = 1;
+    accumulate_contact_forces(state, colliders, force);
+    CHECK(force.get(0) == glm::dvec3(0.0));
+
+    // The sphere pushes along its normal, the same depth as the projection's (radius + t - distance).
+    colliders.ground.enabled = false;
+    colliders.sphere = {true, {0.0f, 0.0f, 0.0f}, 0.5f, 0.0f};
+    state.pinned[0] = 0;
+    const glm::dvec3 dir = glm::normalize(glm::dvec3(1.0, 2.0, -2.0));
+    state.position.set(0, dir * (0.5 + t - p));
+    force.resize(1);
+    accumulate_contact_forces(state, colliders, force);
+    const glm::dvec3 f = force.get(0);
+    CHECK(glm::length(f) == Approx(expected).epsilon(1e-9));
+    CHECK(glm::dot(f, dir) == Approx(glm::length(f)).epsilon(1e-12));
+}
+
+TEST_CASE("penalty contact: a damped particle settles at the depth where k p^3 / t^2 = m g", "[contact_penalty]") {
+    // The analytic rest depth: p = (m g t^2 / k)^(1/3) = 1.349 mm here, 0.27 of the thickness.
+    const double g = 9.81;
+    const double rest = std::cbrt(kMass * g * kThickness * kThickness / kStiffness);
+    struct Case {
+        Integrator integrator;
+        SolverMethod method;
+        const char* name;
+    };
+    for (const Case& c : {Case{Integrator::Verlet, SolverMethod::Fast, "verlet, fast"},
+                          Case{Integrator::Verlet, SolverMethod::Textbook, "verlet, textbook"},
+                          Case{Integrator::Rk4, SolverMethod::Textbook, "rk4"}}) {
+        INFO(c.name);
+        // Released at rest on the shell (p = 0) with damping 20 1/s: the contact rings at about 150 rad/s and
+        // decays as e^(-10 t), to 1e-9 of its swing in 2 s.
+        MassSpring sim = build_simulation(particle_over_ground(kThickness, 20.0f, c.integrator, c.method, 10));
+        REQUIRE(sim.plan().contact);
+        sim.run_steps(150);  // 2.5 s
+        INFO("depth " << depth(sim) << " m, analytic " << rest << " m");
+        CHECK(std::fabs(depth(sim) - rest) < 1e-3 * rest);
+        CHECK(sim.velocities()[0].y == Approx(0.0).margin(1e-6));
+    }
+}
+
+TEST_CASE("penalty contact: an undamped bounce conserves total energy, to RK4's order in the substep",
+          "[contact_penalty]") {
+    // Dropped from 1 cm above the shell, the particle falls for 45 ms, goes 3.4 mm into the ground's shell
+    // (0.69 of the thickness: k p^4 / (4 t^2) = m g (0.01 + p)) and comes back up to where it started. The
+    // largest change of the total energy (kinetic, gravity and contact potential) over the run is RK4's error.
+    const double drop = 0.01;
+    auto worst_energy_error = [&](int substeps) {
+        MassSpring sim = build_simulation(
+            particle_over_ground(kThickness + drop, 0.0f, Integrator::Rk4, SolverMethod::Textbook, substeps));
+        const double e0 = sim.energy().total();
+        double worst = 0.0, deepest = 0.0, contact_energy = 0.0, highest_after = -1.0;
+        for (int step = 0; step < 9; ++step) {  // 0.15 s: down, through the contact, back up to the top
+            for (int i = 0; i < substeps; ++i) {
+                sim.step();
+                const Energy e = sim.energy();
+                worst = std::max(worst, std::fabs(e.total() - e0));
+                deepest = std::max(deepest, depth(sim));
+                contact_energy = std::max(contact_energy, e.contact_potential);
+                if (deepest > 0.0) highest_after = std::max(highest_after, -depth(sim));
+            }
+        }
+        INFO(substeps << " substeps per step: deepest " << deepest << " m, contact energy " << contact_energy
+                      << " J, height reached after it " << highest_after << " m, worst energy error " << worst
+                      << " J of " << e0 << " J");
+        CHECK(deepest > 0.6 * kThickness);  // it went deep into the shell ...
+        CHECK(deepest < kThickness);        // ... without passing the surface
+        CHECK(contact_energy > 0.9 * kMass * 9.81 * drop);  // the fall's energy went into the contact
+        CHECK(highest_after > 0.9 * drop);  // and came back out of it: it bounced
+        return worst / std::fabs(e0);
+    };
+    const double coarse = worst_energy_error(16), fine = worst_energy_error(32), finer = worst_energy_error(64);
+    INFO("relative energy error at h = 1.04, 0.52, 0.26 ms: " << coarse << ", " << fine << ", " << finer);
+    CHECK(finer < 1e-6);
+    CHECK(fine < coarse / 8.0);  // RK4: 1/16 or better per halving; at least 1/8 asked
+    CHECK(finer < fine / 8.0);
+}
+
+TEST_CASE("penalty contact: fast and textbook solvers give bit-identical drapes", "[contact_penalty]") {
+    Scene scene = load_scene("drape-sphere");
+    scene.settings.colliders.contact = ContactModel::Penalty;
+    scene.cloth.origin.y = 0.87f;  // just above the sphere's shell: contact from the first steps
+    scene.settings.solver.sleep_speed = 0.0f;
+    auto run = [&](SolverMethod method) {
+        Scene s = scene;
+        s.settings.solver.method = method;
+        s.settings.solver.threads = 2;
+        MassSpring sim = build_simulation(s);
+        REQUIRE(sim.fast_solver_available());
+        sim.run_steps(20);
+        return sim;
+    };
+    const MassSpring fast = run(SolverMethod::Fast);
+    const MassSpring textbook = run(SolverMethod::Textbook);
+    CHECK(fast.plan().path == StepPath::Fast);
+    CHECK(textbook.plan().path == StepPath::Textbook);
+    CHECK(fast.energy().contact_potential > 0.0);  // the cloth is on the sphere
+    CHECK(fast.all_finite());
+    CHECK(bit_identical(fast, textbook));
+}
+
+TEST_CASE("penalty contact: the stability limit counts 3 k_c per enabled collider", "[contact_penalty]") {
+    const MassSpring sim = build_simulation(load_scene("drape-sphere"));  // sphere and ground enabled
+    SimulationSettings settings = sim.settings();
+    const StabilityLimit projection = stability_limit(sim.topology(), sim.state(), settings);
+    settings.colliders.contact = ContactModel::Penalty;
+    settings.colliders.contact_stiffness = 2000.0f;
+    const StabilityLimit penalty = stability_limit(sim.topology(), sim.state(), settings);
+    const double m = sim.state().mass[0];
+    const double added = 2 * 3.0 * 2000.0 / m;  // two colliders
+    CHECK(penalty.omega_gershgorin * penalty.omega_gershgorin ==
+          Approx(projection.omega_gershgorin * projection.omega_gershgorin + added).epsilon(1e-9));
+    CHECK(penalty.omega_plane_wave * penalty.omega_plane_wave ==
+          Approx(projection.omega_plane_wave * projection.omega_plane_wave + added).epsilon(1e-9));
+    CHECK(penalty.critical_substep < projection.critical_substep);
+
+    // Implicit Euler takes the contact explicitly: no longer unconditionally stable, w_c h < 2.
+    settings.integration.integrator = Integrator::ImplicitEuler;
+    const StabilityLimit implicit = stability_limit(sim.topology(), sim.state(), settings);
+    CHECK_FALSE(implicit.unconditionally_stable);
+    CHECK(implicit.critical_substep == Approx(2.0 / std::sqrt(added)).epsilon(1e-9));
+    settings.colliders.contact = ContactModel::Projection;
+    CHECK(stability_limit(sim.topology(), sim.state(), settings).unconditionally_stable);
+}
+
+TEST_CASE("penalty contact: a drape at the predicted limit stays finite and out of the sphere", "[contact_penalty]") {
+    // The bound is what auto substeps use; at 0.9 of it the stiffest drape (10x the default stiffness) runs.
+    Scene scene = load_scene("drape-sphere");
+    scene.cloth.rows = scene.cloth.cols = 16;
+    scene.settings.colliders.contact = ContactModel::Penalty;
+    scene.settings.colliders.contact_stiffness = 10000.0f;
+    MassSpring sim = build_simulation(scene);
+    const StabilityLimit limit = stability_limit(sim);
+    const int substeps = auto_substeps(limit, scene.settings.integration.dt, 0.9f);
+    test::edit_settings(sim, [&](SimulationSettings& s) { s.integration.substeps = substeps; });
+    sim.run_steps(90);  // 1.5 s: falls onto the sphere and drapes
+    REQUIRE(sim.all_finite());
+    const SphereCollider& sphere = scene.settings.colliders.sphere;
+    double closest = 1e9;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        closest = std::min(closest, static_cast<double>(signed_distance(sphere, sim.position(i))));
+    }
+    INFO(substeps << " substeps per step; closest particle " << closest << " m from the sphere's surface");
+    CHECK(closest > 0.0);                                                 // none went through the surface
+    CHECK(closest < scene.settings.colliders.thickness);                  // and some lie on it
+}

@@ -83,28 +83,41 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, cons
 }
 
 // Asked of the CPU once, on first use.
-bool cpu_has_avx2_fma() {
-    static const bool has_avx2_fma = [] {
+FastKernel cpu_best_kernel() {
+    static const FastKernel best = [] {
         __builtin_cpu_init();
-        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+        if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return FastKernel::Generic;
+        if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")) return FastKernel::Avx512;
+        return FastKernel::Avx2;
     }();
-    return has_avx2_fma;
+    return best;
 }
 
-// Set by force_generic_kernel: the tests run the generic kernel on an AVX2 CPU to check it too.
-bool generic_kernel_forced = false;
+// Set by use_kernel: the tests run every kernel the CPU has.
+std::optional<FastKernel> kernel_forced;
 
-// Whether the AVX2 + FMA kernels run: the CPU has them and no test asked for the generic ones.
-bool use_avx2() { return cpu_has_avx2_fma() && !generic_kernel_forced; }
+FastKernel kernel_in_use() { return kernel_forced ? *kernel_forced : cpu_best_kernel(); }
+bool use_avx2() { return kernel_in_use() != FastKernel::Generic; }
 
 }  // namespace
 
-const char* FastSolver::kernel_name() { return use_avx2() ? "avx2+fma" : "generic"; }
+FastKernel FastSolver::best_kernel() { return cpu_best_kernel(); }
+FastKernel FastSolver::kernel() { return kernel_in_use(); }
 
-bool FastSolver::force_generic_kernel(bool generic) {
-    const bool was_generic = !use_avx2();
-    generic_kernel_forced = generic;
-    return was_generic;
+const char* FastSolver::kernel_name(FastKernel kernel) {
+    switch (kernel) {
+        case FastKernel::Avx512: return "avx512 rows + avx2+fma springs";
+        case FastKernel::Avx2: return "avx2+fma";
+        case FastKernel::Generic: return "generic";
+    }
+    return "generic";
+}
+
+FastKernel FastSolver::use_kernel(FastKernel kernel) {
+    const FastKernel was = kernel_in_use();
+    kernel_forced = static_cast<int>(kernel) <= static_cast<int>(cpu_best_kernel()) ? std::optional(kernel)
+                                                                                     : std::nullopt;
+    return was;
 }
 
 std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
@@ -180,7 +193,8 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         team_.reset();
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
-    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
+    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
+                                       copy_current_};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
     const bool automatic = settings.solver.threads == 0 && blocks > 1;
     const bool single = blocks == 1 || (automatic && team_.next_is_single());
@@ -189,6 +203,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         sweep(state, sweep_settings, 0, rows_, scratch_[0], no_boundary_);
         if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
         state.substep = h;
+        copy_current_ = true;
         return;
     }
     const auto start = std::chrono::steady_clock::now();
@@ -214,6 +229,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     state.substep = h;
+    copy_current_ = true;
 }
 
 // ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----
@@ -258,19 +274,14 @@ template <bool Avx2, unsigned Mask>
         if (!kind_runs(Mask, dir.kind)) continue;
         float* f = out + 3 * d * stride + kPad;  // column 0 of component x
         const int c0 = first_column(dir), c1 = end_column(dir, grid.cols);
-        // Columns without a spring, the padding, rows past the bottom and a direction the topology lacks
-        // hold zero.
+        // Rows past the bottom and a direction the topology lacks hold zero. Columns without a spring and the
+        // padding hold zero too: every spring-row buffer starts zeroed and the kernels write only [c0, c1),
+        // the same columns for a direction in every row.
         const bool any = grid.present[d] && r + dir.dr < grid.rows && c1 > c0;
-        for (int comp = 0; comp < 3; ++comp) {
-            float* row = f + comp * stride;
-            if (!any) {
-                std::memset(row - kPad, 0, stride * sizeof(float));
-                continue;
-            }
-            for (int c = -kPad; c < c0; ++c) row[c] = 0.0f;
-            for (int c = c1; c < grid.cols + kPad; ++c) row[c] = 0.0f;
+        if (!any) {
+            std::memset(f - kPad, 0, 3 * stride * sizeof(float));
+            continue;
         }
-        if (!any) continue;
         const int row_start = r * grid.cols;
         const int offset = dir.dr * grid.cols + dir.dc;
         const float k = stiffness[static_cast<int>(dir.kind)];
@@ -353,6 +364,7 @@ struct SweepInput {
     const Vec3Array* external;
     double h;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
+    bool copy_current;
     float* window;
     const float* zeros;
 };
@@ -366,18 +378,18 @@ template <bool Avx2, unsigned Mask>
     const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
     const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
-    // Rows of the float copy brought up to date so far. Row q is copied just before the first spring row
-    // that reads it (q - 2, or the block's first) and is not written again until its own update, after the
-    // last spring row that reads it: the spring rows see the positions at the start of the substep, as the
-    // textbook solver does, whatever moved them since the last substep (collisions, pins, a rebuild).
-    int copied_end = std::max(begin - 2, 0);
+    // Rows of the float copy brought up to date so far (all when it is current). Row q is copied just before
+    // the first spring row that reads it (q - 2, or the block's first) and is written again only by its own
+    // update, after the last spring row that reads it: the spring rows see the positions at the start of
+    // the substep, as the textbook solver does, whatever moved them since the last substep.
+    int copied_end = in.copy_current ? grid.rows : std::max(begin - 2, 0);
     for (int r = std::max(begin - 2, 0); r < end; ++r) {
         const float* current;
         if (in.boundary_slot[r] >= 0) {
             current = in.boundary.data() + static_cast<std::size_t>(in.boundary_slot[r]) * row_floats;
         } else {
             copy_rows_body(grid, state, std::max(copied_end, r), r + 3);
-            copied_end = r + 3;
+            copied_end = std::max(copied_end, r + 3);
             float* slot = in.window + static_cast<std::size_t>(r % 3) * row_floats;
             spring_row_body<Avx2, Mask>(grid, in.settings.springs, r, slot);
             current = slot;
@@ -404,6 +416,9 @@ template <bool Avx2, unsigned Mask>
         } else {
             integrate_row<Mask, false>(row, grid.cols, stride, keep, h2);
         }
+        // The row's new positions into the float copy while they are in L1 (a loop of its own: written into
+        // the update's loop, the float store defeats GCC's aliasing check and the loop runs scalar).
+        copy_rows_body(grid, state, r, r + 1);
         // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
         if (in.row_boxes) {
             row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
@@ -421,6 +436,14 @@ template <unsigned Mask>
 void spring_row_generic(const Grid& grid, const SpringSettings& springs, int r, float* out) {
     spring_row_body<false, Mask>(grid, springs, r, out);
 }
+// The same sweep with 512-bit vectors for the row update and the copies (8 doubles at a time); the spring
+// kernels stay AVX2. Element-wise IEEE operations without contraction: bit-identical to the others.
+template <unsigned Mask>
+__attribute__((target("avx512f,avx512vl,avx2,fma,prefer-vector-width=512"))) void sweep_avx512(const SweepInput& in,
+                                                                                          State& state, int begin,
+                                                                                          int end) {
+    sweep_body<true, Mask>(in, state, begin, end);
+}
 template <unsigned Mask>
 __attribute__((target("avx2,fma"))) void sweep_avx2(const SweepInput& in, State& state, int begin, int end) {
     sweep_body<true, Mask>(in, state, begin, end);
@@ -437,24 +460,29 @@ constexpr std::array<SpringRowFn, 8> spring_row_table(bool avx2, std::index_sequ
     return avx2 ? std::array<SpringRowFn, 8>{spring_row_avx2<M>...} : std::array<SpringRowFn, 8>{spring_row_generic<M>...};
 }
 template <std::size_t... M>
-constexpr std::array<SweepFn, 8> sweep_table(bool avx2, std::index_sequence<M...>) {
-    return avx2 ? std::array<SweepFn, 8>{sweep_avx2<M>...} : std::array<SweepFn, 8>{sweep_generic<M>...};
+constexpr std::array<SweepFn, 8> sweep_table(FastKernel kernel, std::index_sequence<M...>) {
+    switch (kernel) {
+        case FastKernel::Avx512: return {sweep_avx512<M>...};
+        case FastKernel::Avx2: return {sweep_avx2<M>...};
+        case FastKernel::Generic: break;
+    }
+    return {sweep_generic<M>...};
 }
 
 }  // namespace
 
 void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) {
     const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
-    copy_rows_body(grid, state, r, r + 3);
+    if (!copy_current_) copy_rows_body(grid, state, r, r + 3);
     spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
-    const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
-                        sweep.row_boxes, scratch.window.data(), zeros_.data()};
-    sweep_table(use_avx2(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
+    const SweepInput in{grid,        boundary_,   boundary_slot, sweep.settings, sweep.external, sweep.h,
+                        sweep.row_boxes, sweep.copy_current, scratch.window.data(), zeros_.data()};
+    sweep_table(kernel_in_use(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }
 
 }  // namespace clothsim

@@ -31,6 +31,9 @@
 
 namespace clothsim {
 
+// The instruction sets the fast solver has kernels for, chosen at run time (the best the CPU has).
+enum class FastKernel { Generic, Avx2, Avx512 };
+
 class FastSolver {
 public:
     // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions, each
@@ -49,11 +52,16 @@ public:
     int effective_threads(int requested) const;
     // With threads = 0: whether the last substeps ran on one thread because the team was slower.
     bool team_set_aside() const { return team_.single(); }
-    // Which kernel runs on this CPU: "avx2+fma" or "generic".
-    static const char* kernel_name();
-    // For tests: run the generic kernel even on an AVX2 CPU (true), or go back to the CPU's best (false).
-    // Returns whether the generic kernel was in use before. Not for use while a step runs.
-    static bool force_generic_kernel(bool generic);
+    // The state's positions were moved by something other than step() (a collision, a limit, a pin, another
+    // integrator): the float copy the spring kernels read is copied again at the next step.
+    void positions_changed() { copy_current_ = false; }
+    // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
+    static FastKernel best_kernel();
+    static FastKernel kernel();
+    static const char* kernel_name(FastKernel kernel = FastSolver::kernel());
+    // For tests: run `kernel` (one the CPU has; another goes back to the best) and return the one in use
+    // before. Not for use while a step runs.
+    static FastKernel use_kernel(FastKernel kernel);
 
 private:
     FastSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
@@ -67,19 +75,23 @@ private:
         const Vec3Array* external;
         double h;
         Box* row_boxes;
+        bool copy_current;  // the float copy holds the positions: no row needs copying before it is read
     };
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);
     // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols);
-    // brings rows r to r + 2 of the float copy up to date first.
+    // brings rows r to r + 2 of the float copy up to date first unless it is current.
     void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out);
 
     int rows_, cols_;
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
     // The positions rounded to float, what the spring kernels read: half the bytes of the double state and
-    // eight springs per AVX2 vector. Scratch of the sweep: each substep copies every row before reading it.
+    // eight springs per AVX2 vector. The sweep writes each row's new positions into it as it updates them,
+    // so it stays current from substep to substep; whoever else moves a particle calls positions_changed(),
+    // and the next sweep copies every row again before reading it.
     std::array<std::vector<float>, 3> copy_;
+    bool copy_current_ = false;
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

@@ -3,6 +3,7 @@
 
 #include "clothsim/scene.hpp"
 
+#include <cstring>
 #include <initializer_list>
 
 namespace clothsim::test {
@@ -35,6 +36,19 @@ inline Scene chain(int particles, float spacing, float particle_mass, float k) {
     s.settings.colliders.ground.enabled = false;
     s.settings.integration.substeps = 1;
     return s;
+}
+
+// Whether two simulations hold the same positions and motion, bit for bit.
+inline bool bit_identical(const MassSpring& a, const MassSpring& b) {
+    const State& sa = a.state();
+    const State& sb = b.state();
+    const std::size_t bytes = sa.size() * sizeof(sa.position.x[0]);
+    return sa.size() == sb.size() && std::memcmp(sa.position.x.data(), sb.position.x.data(), bytes) == 0 &&
+           std::memcmp(sa.position.y.data(), sb.position.y.data(), bytes) == 0 &&
+           std::memcmp(sa.position.z.data(), sb.position.z.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.x.data(), sb.motion.x.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.y.data(), sb.motion.y.data(), bytes) == 0 &&
+           std::memcmp(sa.motion.z.data(), sb.motion.z.data(), bytes) == 0;
 }
 
 // Changes `sim`'s live settings through its one call (MassSpring::apply), as the panel does.

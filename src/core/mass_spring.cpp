@@ -157,14 +157,7 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     const Vec3Array* external = nullptr;
     if (plan_.wind || plan_.contact) {
         force_.resize(state_.size());
-        if (plan_.wind) {
-            StageTimer timer(profile, Stage::Wind);
-            accumulate_wind_forces(topology_, state_, settings_.forces, rest_area_, force_);
-        }
-        if (plan_.contact) {
-            StageTimer timer(profile, Stage::Contact);
-            accumulate_contact_forces(state_, settings_.colliders, force_);
-        }
+        add_external_forces(state_, force_, external_, profile);  // onto zeros: the sums themselves
         if (grab_) force_.add(grab_->particle, grab_force(state_));
         external = &force_;
     } else if (grab_) {

@@ -42,17 +42,6 @@ Scene particle_over_ground(double y, float damping, Integrator integrator, Solve
 // m: how deep the particle is in the ground's shell (thickness minus height).
 double depth(const MassSpring& sim) { return double(sim.settings().colliders.thickness) - sim.state().position.y[0]; }
 
-bool bit_identical(const MassSpring& a, const MassSpring& b) {
-    const State& sa = a.state();
-    const State& sb = b.state();
-    const std::size_t bytes = sa.size() * sizeof(double);
-    return sa.size() == sb.size() && std::memcmp(sa.position.x.data(), sb.position.x.data(), bytes) == 0 &&
-           std::memcmp(sa.position.y.data(), sb.position.y.data(), bytes) == 0 &&
-           std::memcmp(sa.position.z.data(), sb.position.z.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.x.data(), sb.motion.x.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.y.data(), sb.motion.y.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.z.data(), sb.motion.z.data(), bytes) == 0;
-}
 
 }  // namespace
 
@@ -177,7 +166,7 @@ TEST_CASE("penalty contact: fast and textbook solvers give bit-identical drapes"
     CHECK(textbook.plan().path == StepPath::Textbook);
     CHECK(fast.energy().contact_potential > 0.0);  // the cloth is on the sphere
     CHECK(fast.all_finite());
-    CHECK(bit_identical(fast, textbook));
+    CHECK(test::bit_identical(fast, textbook));
 }
 
 TEST_CASE("penalty contact: the stability limit counts 3 k_c per enabled collider", "[contact_penalty]") {

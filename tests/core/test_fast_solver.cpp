@@ -30,17 +30,6 @@ MassSpring run(Scene scene, SolverMethod method, int threads, long long substeps
     return sim;
 }
 
-bool bit_identical(const MassSpring& a, const MassSpring& b) {
-    const State& sa = a.state();
-    const State& sb = b.state();
-    const std::size_t bytes = sa.size() * sizeof(sa.position.x[0]);
-    return std::memcmp(sa.position.x.data(), sb.position.x.data(), bytes) == 0 &&
-           std::memcmp(sa.position.y.data(), sb.position.y.data(), bytes) == 0 &&
-           std::memcmp(sa.position.z.data(), sb.position.z.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.x.data(), sb.motion.x.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.y.data(), sb.motion.y.data(), bytes) == 0 &&
-           std::memcmp(sa.motion.z.data(), sb.motion.z.data(), bytes) == 0;
-}
 
 }  // namespace
 
@@ -72,7 +61,7 @@ TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solv
             const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
             const MassSpring fast = run(scene, SolverMethod::Fast, 2, 1000);
             INFO(name << " with the " << FastSolver::kernel_name() << " kernel");
-            CHECK(bit_identical(fast, textbook));
+            CHECK(test::bit_identical(fast, textbook));
         }
         FastSolver::use_kernel(was);
     }
@@ -88,7 +77,7 @@ TEST_CASE("fast solver gives bit-identical positions for any thread count", "[fa
             const MassSpring many = run(scene, SolverMethod::Fast, threads, 300);
             INFO(name << " with " << threads << " threads (" << many.solver_threads() << " blocks)");
             CHECK(many.solver_threads() == threads);
-            CHECK(bit_identical(one, many));
+            CHECK(test::bit_identical(one, many));
         }
     }
 }
@@ -153,7 +142,7 @@ TEST_CASE("fast solver steps every row block when OpenMP gives fewer threads tha
         for (int i = 0; i < 100; ++i) nested.step();
     }
     CHECK(nested.solver_threads() == 4);
-    CHECK(bit_identical(one, nested));
+    CHECK(test::bit_identical(one, nested));
 }
 
 TEST_CASE("fast solver: automatic threads switch between the team and one thread without changing a bit") {
@@ -252,6 +241,6 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
         INFO(threads << " threads");
         const MassSpring fast = script(SolverMethod::Fast, threads);
         CHECK(fast.all_finite());
-        CHECK(bit_identical(fast, textbook));
+        CHECK(test::bit_identical(fast, textbook));
     }
 }

@@ -159,8 +159,6 @@ private:
     void step_textbook(double h, StepProfile* profile);
     void step_velocity_integrator(Integrator integrator, double h);
     void collide(StepProfile* profile);
-    // Something other than the fast solver's sweep moved particles: its float copy is refreshed next time.
-    void positions_moved();
     void limit_strain();
     void limit_speed(double h);
     void check_sleep(double h);

@@ -144,21 +144,17 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
     return std::max(deepest * (T(1) + friction), deepest);
 }
 
-// Returns whether it moved any particle.
 template <class Shape>
-bool collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
+void collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
                     int which, StepProfile* profile) {
     long long tested = 0;
-    bool any = false;
     // First the whole cloth: a collider out of its reach costs this one test.
     const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
     for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
         ++tested;
-        const double pushed = collide_shape(state, shape, double(shape.friction), double(thickness), begin, end);
-        any = any || pushed > 0.0;
-        const float moved = static_cast<float>(pushed);
+        const float moved = static_cast<float>(collide_shape(state, shape, double(shape.friction), double(thickness), begin, end));
         if (moved > 0.0f && broad_phase) {
             // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
             // conservative for the next collider, and O(1).
@@ -175,7 +171,6 @@ bool collide_blocks(State& state, const Shape& shape, float thickness, bool broa
         profile->blocks_tested[which] += tested;
         profile->blocks_offered[which] += static_cast<long long>(blocks.count());
     }
-    return any;
 }
 
 }  // namespace
@@ -199,7 +194,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     if (colliders.cube.enabled) collide_shape(state, colliders.cube, T(colliders.cube.friction), thickness, begin, end);
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
-bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
+void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
         blocks.start = block_starts(state.size(), 0, 0);
@@ -207,7 +202,7 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     }
     const std::size_t count = blocks.count();
     const bool any = colliders.sphere.enabled || colliders.cube.enabled || colliders.ground.enabled;
-    if (!any) return false;
+    if (!any) return;
     if (!broad_phase) {
         blocks.boxes.resize(count);  // only counted: every block is tested
         blocks.current = blocks.boxes_current = false;
@@ -238,20 +233,18 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.boxes_current = blocks.current = true;
     }
     const float thickness = colliders.thickness;
-    bool moved = false;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        if (collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile)) moved = true;
+        collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        if (collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile)) moved = true;
+        collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        if (collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile)) moved = true;
+        collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
     }
-    return moved;
 }
 
 void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {

@@ -36,19 +36,23 @@ int first_column(const Direction& d) { return std::max(0, -d.dc); }
 int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); }
 
 // Spring forces of one run of springs, F_a = s d with s = k (|d| - L0) / |d| (s = k for L0 = 0; no force
-// when the ends of a spring with L0 > 0 coincide). The positions read are the state's double positions
-// rounded to float (the sweep's float copy). The arithmetic is the textbook solver's, operation for
-// operation ((dx dx + dy dy) + dz dz, sqrt, (k (len - L0)) / len; no fused multiply-add), so the two
-// solvers give bit-identical results and the textbook solver is an exact oracle. sqrt and divide are
-// correctly rounded, so the AVX2 and the generic kernels agree bit for bit too.
+// when the ends of a spring with L0 > 0 coincide). Positions are double: d is their difference taken in
+// double and rounded once to float (relative error 6e-8 of d itself, where rounding the positions first
+// would leave an absolute 6e-8 m of the position: 25x the error on the accuracy study's drape), then float
+// arithmetic. It is the textbook solver's, operation for operation ((dx dx + dy dy) + dz dz, sqrt,
+// (k (len - L0)) / len; no fused multiply-add), so the two solvers give bit-identical results and the
+// textbook solver is an exact oracle. Subtraction, conversion, sqrt and divide are correctly rounded, so
+// the generic, AVX2 and AVX-512 kernels agree bit for bit too.
 //
 // Generic kernel: auto-vectorised for the baseline ISA.
-[[gnu::always_inline]] inline void spring_forces_generic(const float* __restrict x, const float* __restrict y,
-                                                       const float* __restrict z, const float* __restrict rest,
+[[gnu::always_inline]] inline void spring_forces_generic(const double* __restrict x, const double* __restrict y,
+                                                       const double* __restrict z, const float* __restrict rest,
                                                        int offset, int begin, int end, float k, float* __restrict fx,
                                                        float* __restrict fy, float* __restrict fz) {
     for (int i = begin; i < end; ++i) {
-        const float dx = x[i + offset] - x[i], dy = y[i + offset] - y[i], dz = z[i + offset] - z[i];
+        const float dx = static_cast<float>(x[i + offset] - x[i]);
+        const float dy = static_cast<float>(y[i + offset] - y[i]);
+        const float dz = static_cast<float>(z[i + offset] - z[i]);
         const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
         const float stretched = k * (length - rest[i]) / length;
         const float s = rest[i] == 0.0f ? k : (length > 1e-12f ? stretched : 0.0f);
@@ -58,26 +62,57 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
     }
 }
 
-// AVX2 kernel: the same operations eight springs at a time; the tail reuses the generic loop.
-__attribute__((target("avx2,fma"))) void spring_forces_avx2(const float* x, const float* y, const float* z,
+// Eight springs from their differences: the float arithmetic both vector kernels share.
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void forces8(__m256 dx, __m256 dy, __m256 dz,
+                                                                                const float* rest, float k,
+                                                                                float* fx, float* fy, float* fz) {
+    const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
+    const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                    _mm256_mul_ps(dz, dz));
+    const __m256 length = _mm256_sqrt_ps(r2);
+    const __m256 l0 = _mm256_loadu_ps(rest);
+    const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, _mm256_sub_ps(length, l0)), length);
+    const __m256 apart = _mm256_blendv_ps(zero, stretched, _mm256_cmp_ps(length, tiny, _CMP_GT_OQ));
+    const __m256 s = _mm256_blendv_ps(apart, vk, _mm256_cmp_ps(l0, zero, _CMP_EQ_OQ));
+    _mm256_storeu_ps(fx, _mm256_mul_ps(s, dx));
+    _mm256_storeu_ps(fy, _mm256_mul_ps(s, dy));
+    _mm256_storeu_ps(fz, _mm256_mul_ps(s, dz));
+}
+
+// Eight differences p[i + offset] - p[i] in double, rounded to float: two 4-wide halves with AVX2, ...
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m256 difference8_avx2(const double* p, int i,
+                                                                                          int offset) {
+    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset), _mm256_loadu_pd(p + i)));
+    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset + 4), _mm256_loadu_pd(p + i + 4)));
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
+}
+// ... one 8-wide subtraction and conversion with AVX-512.
+[[gnu::always_inline]] __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m256 difference8_avx512(
+    const double* p, int i, int offset) {
+    // maskz with all lanes: _mm512_cvtpd_ps itself trips GCC 12's -Wmaybe-uninitialized in its header.
+    return _mm512_maskz_cvtpd_ps(0xFF, _mm512_sub_pd(_mm512_loadu_pd(p + i + offset), _mm512_loadu_pd(p + i)));
+}
+
+// The vector kernels: eight springs at a time; the tail reuses the generic loop.
+__attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, const double* y, const double* z,
                                                              const float* rest, int offset, int begin, int end,
                                                              float k, float* fx, float* fy, float* fz) {
-    const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
     int i = begin;
     for (; i + 8 <= end; i += 8) {
-        const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + i + offset), _mm256_loadu_ps(x + i));
-        const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + i + offset), _mm256_loadu_ps(y + i));
-        const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + i + offset), _mm256_loadu_ps(z + i));
-        const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                                        _mm256_mul_ps(dz, dz));
-        const __m256 length = _mm256_sqrt_ps(r2);
-        const __m256 l0 = _mm256_loadu_ps(rest + i);
-        const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, _mm256_sub_ps(length, l0)), length);
-        const __m256 apart = _mm256_blendv_ps(zero, stretched, _mm256_cmp_ps(length, tiny, _CMP_GT_OQ));
-        const __m256 s = _mm256_blendv_ps(apart, vk, _mm256_cmp_ps(l0, zero, _CMP_EQ_OQ));
-        _mm256_storeu_ps(fx + (i - begin), _mm256_mul_ps(s, dx));
-        _mm256_storeu_ps(fy + (i - begin), _mm256_mul_ps(s, dy));
-        _mm256_storeu_ps(fz + (i - begin), _mm256_mul_ps(s, dz));
+        forces8(difference8_avx2(x, i, offset), difference8_avx2(y, i, offset), difference8_avx2(z, i, offset),
+                rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+    }
+    spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) void spring_forces_avx512(const double* x, const double* y,
+                                                                               const double* z, const float* rest,
+                                                                               int offset, int begin, int end,
+                                                                               float k, float* fx, float* fy,
+                                                                               float* fz) {
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        forces8(difference8_avx512(x, i, offset), difference8_avx512(y, i, offset), difference8_avx512(z, i, offset),
+                rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
     }
     spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
@@ -97,7 +132,6 @@ FastKernel cpu_best_kernel() {
 std::optional<FastKernel> kernel_forced;
 
 FastKernel kernel_in_use() { return kernel_forced ? *kernel_forced : cpu_best_kernel(); }
-bool use_avx2() { return kernel_in_use() != FastKernel::Generic; }
 
 }  // namespace
 
@@ -124,7 +158,6 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     if (t.rows < 1 || t.cols < 1) return std::nullopt;
     FastSolver solver(t.rows, t.cols);
     const std::size_t n = static_cast<std::size_t>(t.rows) * t.cols;
-    for (auto& c : solver.copy_) c.assign(n, 0.0f);
     // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
     // exactly one spring for the sweep to be the same model as the spring list.
     for (auto& r : solver.rest_) r.assign(n, NAN);
@@ -193,8 +226,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         team_.reset();
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
-    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
-                                       copy_current_};
+    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
     const bool automatic = settings.solver.threads == 0 && blocks > 1;
     const bool single = blocks == 1 || (automatic && team_.next_is_single());
@@ -203,7 +235,6 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         sweep(state, sweep_settings, 0, rows_, scratch_[0], no_boundary_);
         if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
         state.substep = h;
-        copy_current_ = true;
         return;
     }
     const auto start = std::chrono::steady_clock::now();
@@ -229,7 +260,6 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     state.substep = h;
-    copy_current_ = true;
 }
 
 // ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----
@@ -240,7 +270,6 @@ struct Grid {
     int rows, cols;
     const std::array<std::vector<float>, 6>& rest;
     const std::array<bool, 6>& present;
-    const std::array<float*, 3> copy;  // the float copy of the positions the spring rows read (x, y, z)
     std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
     // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
     std::size_t row_floats() const { return 18 * stride(); }
@@ -248,25 +277,10 @@ struct Grid {
 
 constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
 
-// Rows [begin, end) of the float copy from the state's double positions (rounded to nearest).
-[[gnu::always_inline]] inline void copy_rows_body(const Grid& grid, const State& state, int begin, int end) {
-    end = std::min(end, grid.rows);
-    if (begin >= end) return;
-    const std::size_t i0 = static_cast<std::size_t>(begin) * grid.cols;
-    const std::size_t n = static_cast<std::size_t>(end - begin) * grid.cols;
-    const double* from[3] = {state.position.x.data() + i0, state.position.y.data() + i0, state.position.z.data() + i0};
-    for (int comp = 0; comp < 3; ++comp) {
-        const double* __restrict in = from[comp];
-        float* __restrict out = grid.copy[comp] + i0;
-        for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(in[i]);
-    }
-}
-
 // Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
-// Reads rows r, r + 1 and r + 2 of the float copy, which the caller has brought up to date.
-template <bool Avx2, unsigned Mask>
-[[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const SpringSettings& springs, int r,
-                                                   float* out) {
+template <FastKernel K, unsigned Mask>
+[[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state, const SpringSettings& springs,
+                                                   int r, float* out) {
     const std::size_t stride = grid.stride();
     const float stiffness[3] = {springs.structural, springs.shear, springs.bending};
     for (int d = 0; d < 6; ++d) {
@@ -285,12 +299,19 @@ template <bool Avx2, unsigned Mask>
         const int row_start = r * grid.cols;
         const int offset = dir.dr * grid.cols + dir.dc;
         const float k = stiffness[static_cast<int>(dir.kind)];
-        if constexpr (Avx2) {
-            spring_forces_avx2(grid.copy[0], grid.copy[1], grid.copy[2], grid.rest[d].data(), offset,
-                               row_start + c0, row_start + c1, k, f + c0, f + stride + c0, f + 2 * stride + c0);
+        const double* x = state.position.x.data();
+        const double* y = state.position.y.data();
+        const double* z = state.position.z.data();
+        const int begin = row_start + c0, end = row_start + c1;
+        if constexpr (K == FastKernel::Avx512) {
+            spring_forces_avx512(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+                                 f + 2 * stride + c0);
+        } else if constexpr (K == FastKernel::Avx2) {
+            spring_forces_avx2(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+                               f + 2 * stride + c0);
         } else {
-            spring_forces_generic(grid.copy[0], grid.copy[1], grid.copy[2], grid.rest[d].data(), offset,
-                                  row_start + c0, row_start + c1, k, f + c0, f + stride + c0, f + 2 * stride + c0);
+            spring_forces_generic(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+                                  f + 2 * stride + c0);
         }
     }
 }
@@ -364,12 +385,11 @@ struct SweepInput {
     const Vec3Array* external;
     double h;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
-    bool copy_current;
     float* window;
     const float* zeros;
 };
 
-template <bool Avx2, unsigned Mask>
+template <FastKernel K, unsigned Mask>
 [[gnu::always_inline]] inline void sweep_body(const SweepInput& in, State& state, int begin, int end) {
     const Grid& grid = in.grid;
     const std::size_t stride = grid.stride();
@@ -378,20 +398,13 @@ template <bool Avx2, unsigned Mask>
     const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
     const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
-    // Rows of the float copy brought up to date so far (all when it is current). Row q is copied just before
-    // the first spring row that reads it (q - 2, or the block's first) and is written again only by its own
-    // update, after the last spring row that reads it: the spring rows see the positions at the start of
-    // the substep, as the textbook solver does, whatever moved them since the last substep.
-    int copied_end = in.copy_current ? grid.rows : std::max(begin - 2, 0);
     for (int r = std::max(begin - 2, 0); r < end; ++r) {
         const float* current;
         if (in.boundary_slot[r] >= 0) {
             current = in.boundary.data() + static_cast<std::size_t>(in.boundary_slot[r]) * row_floats;
         } else {
-            copy_rows_body(grid, state, std::max(copied_end, r), r + 3);
-            copied_end = std::max(copied_end, r + 3);
             float* slot = in.window + static_cast<std::size_t>(r % 3) * row_floats;
-            spring_row_body<Avx2, Mask>(grid, in.settings.springs, r, slot);
+            spring_row_body<K, Mask>(grid, state, in.settings.springs, r, slot);
             current = slot;
         }
         spring_rows[2] = spring_rows[1];
@@ -416,9 +429,6 @@ template <bool Avx2, unsigned Mask>
         } else {
             integrate_row<Mask, false>(row, grid.cols, stride, keep, h2);
         }
-        // The row's new positions into the float copy while they are in L1 (a loop of its own: written into
-        // the update's loop, the float store defeats GCC's aliasing check and the loop runs scalar).
-        copy_rows_body(grid, state, r, r + 1);
         // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
         if (in.row_boxes) {
             row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
@@ -426,38 +436,50 @@ template <bool Avx2, unsigned Mask>
     }
 }
 
-// One compiled sweep per spring-kind mask and instruction set, picked from a table at run time.
+// One compiled sweep per spring-kind mask and instruction set, picked from a table at run time. The AVX-512
+// one also runs the row update and the differences with 512-bit vectors (8 doubles at a time): element-wise
+// IEEE operations without contraction, bit-identical to the others.
+#define CLOTHSIM_AVX512 __attribute__((target("avx512f,avx512vl,avx2,fma,prefer-vector-width=512")))
+#define CLOTHSIM_AVX2 __attribute__((target("avx2,fma")))
 template <unsigned Mask>
-__attribute__((target("avx2,fma"))) void spring_row_avx2(const Grid& grid, const SpringSettings& springs, int r,
-                                                          float* out) {
-    spring_row_body<true, Mask>(grid, springs, r, out);
+CLOTHSIM_AVX512 void spring_row_avx512(const Grid& grid, const State& state, const SpringSettings& springs, int r,
+                                       float* out) {
+    spring_row_body<FastKernel::Avx512, Mask>(grid, state, springs, r, out);
 }
 template <unsigned Mask>
-void spring_row_generic(const Grid& grid, const SpringSettings& springs, int r, float* out) {
-    spring_row_body<false, Mask>(grid, springs, r, out);
-}
-// The same sweep with 512-bit vectors for the row update and the copies (8 doubles at a time); the spring
-// kernels stay AVX2. Element-wise IEEE operations without contraction: bit-identical to the others.
-template <unsigned Mask>
-__attribute__((target("avx512f,avx512vl,avx2,fma,prefer-vector-width=512"))) void sweep_avx512(const SweepInput& in,
-                                                                                          State& state, int begin,
-                                                                                          int end) {
-    sweep_body<true, Mask>(in, state, begin, end);
+CLOTHSIM_AVX2 void spring_row_avx2(const Grid& grid, const State& state, const SpringSettings& springs, int r,
+                                   float* out) {
+    spring_row_body<FastKernel::Avx2, Mask>(grid, state, springs, r, out);
 }
 template <unsigned Mask>
-__attribute__((target("avx2,fma"))) void sweep_avx2(const SweepInput& in, State& state, int begin, int end) {
-    sweep_body<true, Mask>(in, state, begin, end);
+void spring_row_generic(const Grid& grid, const State& state, const SpringSettings& springs, int r, float* out) {
+    spring_row_body<FastKernel::Generic, Mask>(grid, state, springs, r, out);
+}
+template <unsigned Mask>
+CLOTHSIM_AVX512 void sweep_avx512(const SweepInput& in, State& state, int begin, int end) {
+    sweep_body<FastKernel::Avx512, Mask>(in, state, begin, end);
+}
+template <unsigned Mask>
+CLOTHSIM_AVX2 void sweep_avx2(const SweepInput& in, State& state, int begin, int end) {
+    sweep_body<FastKernel::Avx2, Mask>(in, state, begin, end);
 }
 template <unsigned Mask>
 void sweep_generic(const SweepInput& in, State& state, int begin, int end) {
-    sweep_body<false, Mask>(in, state, begin, end);
+    sweep_body<FastKernel::Generic, Mask>(in, state, begin, end);
 }
+#undef CLOTHSIM_AVX512
+#undef CLOTHSIM_AVX2
 
-using SpringRowFn = void (*)(const Grid&, const SpringSettings&, int, float*);
+using SpringRowFn = void (*)(const Grid&, const State&, const SpringSettings&, int, float*);
 using SweepFn = void (*)(const SweepInput&, State&, int, int);
 template <std::size_t... M>
-constexpr std::array<SpringRowFn, 8> spring_row_table(bool avx2, std::index_sequence<M...>) {
-    return avx2 ? std::array<SpringRowFn, 8>{spring_row_avx2<M>...} : std::array<SpringRowFn, 8>{spring_row_generic<M>...};
+constexpr std::array<SpringRowFn, 8> spring_row_table(FastKernel kernel, std::index_sequence<M...>) {
+    switch (kernel) {
+        case FastKernel::Avx512: return {spring_row_avx512<M>...};
+        case FastKernel::Avx2: return {spring_row_avx2<M>...};
+        case FastKernel::Generic: break;
+    }
+    return {spring_row_generic<M>...};
 }
 template <std::size_t... M>
 constexpr std::array<SweepFn, 8> sweep_table(FastKernel kernel, std::index_sequence<M...>) {
@@ -471,17 +493,16 @@ constexpr std::array<SweepFn, 8> sweep_table(FastKernel kernel, std::index_seque
 
 }  // namespace
 
-void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) {
-    const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
-    if (!copy_current_) copy_rows_body(grid, state, r, r + 3);
-    spring_row_table(use_avx2(), std::make_index_sequence<8>())[mask & 7u](grid, springs, r, out);
+void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
+    const Grid grid{rows_, cols_, rest_, present_};
+    spring_row_table(kernel_in_use(), std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
-    const Grid grid{rows_, cols_, rest_, present_, {copy_[0].data(), copy_[1].data(), copy_[2].data()}};
-    const SweepInput in{grid,        boundary_,   boundary_slot, sweep.settings, sweep.external, sweep.h,
-                        sweep.row_boxes, sweep.copy_current, scratch.window.data(), zeros_.data()};
+    const Grid grid{rows_, cols_, rest_, present_};
+    const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
+                        sweep.row_boxes, scratch.window.data(), zeros_.data()};
     sweep_table(kernel_in_use(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
 }
 

@@ -11,9 +11,9 @@
 //    (position Verlet) and, while the row is still in L1, writes the boxes of its particle blocks for the
 //    collision broad phase. Collisions are not part of the sweep: the caller's collision stage runs after
 //    it (collide_stage in colliders.hpp).
-//  - The state is double (state.hpp); the spring kernels read a float copy of the positions, which the
-//    sweep writes row by row just before the first spring row that reads it. Each particle's state is read
-//    twice (for the copy, and two rows later, still in L1, for the update) and written once.
+//  - The state is double (state.hpp): the spring kernels take each difference in double and round it to
+//    float, the row update adds a float change to the double motion. Every particle's data is read and
+//    written once. AVX-512 (when the CPU has it) does the differences and the update 8 doubles at a time.
 //  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
 //    two spring rows just above it; they are computed before a barrier into shared storage and both
 //    neighbouring threads use the stored values. Each particle's force is summed in the same order for
@@ -52,9 +52,6 @@ public:
     int effective_threads(int requested) const;
     // With threads = 0: whether the last substeps ran on one thread because the team was slower.
     bool team_set_aside() const { return team_.single(); }
-    // The state's positions were moved by something other than step() (a collision, a limit, a pin, another
-    // integrator): the float copy the spring kernels read is copied again at the next step.
-    void positions_changed() { copy_current_ = false; }
     // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
     static FastKernel best_kernel();
     static FastKernel kernel();
@@ -75,23 +72,15 @@ private:
         const Vec3Array* external;
         double h;
         Box* row_boxes;
-        bool copy_current;  // the float copy holds the positions: no row needs copying before it is read
     };
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);
-    // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols);
-    // brings rows r to r + 2 of the float copy up to date first unless it is current.
-    void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out);
+    // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).
+    void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const;
 
     int rows_, cols_;
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
-    // The positions rounded to float, what the spring kernels read: half the bytes of the double state and
-    // eight springs per AVX2 vector. The sweep writes each row's new positions into it as it updates them,
-    // so it stays current from substep to substep; whoever else moves a particle calls positions_changed(),
-    // and the next sweep copies every row again before reading it.
-    std::array<std::vector<float>, 3> copy_;
-    bool copy_current_ = false;
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

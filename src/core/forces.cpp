@@ -16,9 +16,7 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
     for (const Spring& s : topology.springs) {
         const T ks = k[static_cast<int>(s.kind)];
         if (ks == T(0)) continue;
-        // Float forces read the positions rounded to float, as the fast solver's kernels do; double forces
-        // the positions themselves.
-        const Vec d = Vec(position.get(s.b)) - Vec(position.get(s.a));
+        const Vec d(position.get(s.b) - position.get(s.a));  // the difference in double, rounded once to T
         const T rest = s.rest_length;
         T scale;  // f_a = scale * d
         if (rest == T(0)) {

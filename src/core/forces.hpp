@@ -9,8 +9,8 @@ namespace clothsim {
 // Hooke springs, F_a = k (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
-// Computed in the force type F from the positions rounded to F. Instantiated for float (the simulation; the
-// fast solver rounds operation for operation alike) and double (the reference).
+// d is taken in double and rounded once to the force type F; the rest is computed in F. Instantiated for
+// float (the simulation; the fast solver rounds operation for operation alike) and double (the reference).
 template <class F>
 void accumulate_spring_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
                               BasicVec3Array<F>& force);

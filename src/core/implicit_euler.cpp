@@ -19,7 +19,7 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
     for (const Spring& s : topology.springs) {
         const float k = stiffness_of(springs, s.kind);
         if (k == 0.0f) continue;
-        const glm::vec3 d = glm::vec3(position.get(s.b)) - glm::vec3(position.get(s.a));
+        const glm::vec3 d(position.get(s.b) - position.get(s.a));
         const float length = glm::length(d);
         const glm::vec3 du = u.get(s.b) - u.get(s.a);
         glm::vec3 f;

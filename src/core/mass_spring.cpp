@@ -115,14 +115,10 @@ void MassSpring::step() {
 
     switch (plan_.path) {
         case StepPath::Fast: step_fast(h, profile); break;
-        case StepPath::Textbook:
-            step_textbook(h, profile);
-            positions_moved();
-            break;
+        case StepPath::Textbook: step_textbook(h, profile); break;
         case StepPath::VelocityIntegrator: {
             StageTimer timer(profile, Stage::Integrate);
             step_velocity_integrator(integrator, h);
-            positions_moved();
         } break;
     }
     collide(profile);
@@ -136,7 +132,6 @@ void MassSpring::step() {
             limit_speed(h);
         }
         blocks_.current = blocks_.boxes_current = false;
-        positions_moved();
         collide(profile);  // a correction must not leave a particle inside a collider
     }
     state_.time += h;
@@ -189,11 +184,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
 
 void MassSpring::collide(StepProfile* profile) {
     if (!plan_.any_collider()) return;
-    if (collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile)) positions_moved();
-}
-
-void MassSpring::positions_moved() {
-    if (fast_.solver) fast_.solver->positions_changed();
+    collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
 }
 
 void MassSpring::replan() {
@@ -473,7 +464,6 @@ void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
     stamp_ = next_stamp();
     state_.position.set(i, glm::dvec3(position));
     state_.motion.set(i, glm::dvec3(0.0));
-    positions_moved();
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {
@@ -481,7 +471,6 @@ void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 veloc
     stamp_ = next_stamp();
     std::vector<glm::dvec3> v = velocities_in_double();
     state_.position.set(i, glm::dvec3(position));
-    positions_moved();
     v.at(i) = state_.pinned[i] ? glm::dvec3(0.0) : glm::dvec3(velocity);
     restart(v, substep_length());
 }

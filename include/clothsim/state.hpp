@@ -61,9 +61,9 @@ struct Topology {
 // cloth freezes), or rounds every substep's update the same way (the error grows with the substep count).
 // In double the update keeps 29 more bits: at 4096 substeps per 1/60 s step the relative rounding per
 // substep is 1e-16 and 2.5e5 of them cost 3e-11 (docs/ACCURACY.md has the measurements). What does not
-// accumulate stays float, which keeps the spring kernels' speed: forces (from the positions rounded to
-// float), masses, and the substep's velocity change a h^2 (rounded once per substep, relative 6e-8, the
-// force's own precision) before it is added to the double motion.
+// accumulate stays float, which keeps the spring kernels' speed: forces (from each spring's difference
+// x_b - x_a taken in double and rounded once), masses, and the substep's velocity change a h^2 (rounded
+// once per substep, relative 6e-8, the force's own precision) before it is added to the double motion.
 struct State {
     DVec3Array position;  // m
     // m: x - x_prev, the motion of the last substep. Position Verlet's previous positions are x - motion.

@@ -98,8 +98,7 @@ public:
     int solver_threads() const;
     // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
     int last_solver_iterations() const { return last_iterations_; }
-    // The fast solver's kernels on this CPU (chosen at run time): "avx512 rows + avx2+fma springs",
-    // "avx2+fma" or "generic".
+    // The fast solver's kernels on this CPU (chosen at run time): "avx512", "avx2+fma" or "generic".
     static const char* fast_kernel_name();
 
     // The stages the current settings run.

@@ -140,7 +140,7 @@ FastKernel FastSolver::kernel() { return kernel_in_use(); }
 
 const char* FastSolver::kernel_name(FastKernel kernel) {
     switch (kernel) {
-        case FastKernel::Avx512: return "avx512 rows + avx2+fma springs";
+        case FastKernel::Avx512: return "avx512";
         case FastKernel::Avx2: return "avx2+fma";
         case FastKernel::Generic: return "generic";
     }

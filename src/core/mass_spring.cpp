@@ -62,7 +62,9 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     }
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
     replan();
-    restart(std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()), substep_length());
+    restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
+                                     : std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()),
+            substep_length());
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
 }
@@ -278,8 +280,10 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
-        if (plan_.wind) accumulate_wind_forces(topology_, s, settings_.forces, rest_area_, f);
-        if (plan_.contact) accumulate_contact_forces(s, settings_.colliders, f);
+        if (plan_.wind || plan_.contact) {
+            Vec3Array scratch;
+            add_external_forces(s, f, scratch, nullptr);
+        }
         if (grab_) f.add(grab_->particle, grab_force(s));
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
@@ -366,10 +370,7 @@ void MassSpring::run_steps(long long steps) {
     }
 }
 
-void MassSpring::restart(const std::vector<glm::dvec3>& given, double h) {
-    // Rest where no velocity is given (an empty list).
-    const std::vector<glm::dvec3>& velocity =
-        given.empty() ? std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)) : given;
+void MassSpring::restart(const std::vector<glm::dvec3>& velocity, double h) {
     const Integrator integrator = settings_.integration.integrator;
     state_.integrator = integrator;
     if (integrator == Integrator::Verlet) {

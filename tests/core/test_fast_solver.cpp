@@ -187,8 +187,8 @@ TEST_CASE("team choice: uses the faster of team and one thread, probing the othe
 
 TEST_CASE("fast solver sees particles moved between its substeps by collisions, limits, pins, tools and another "
           "integrator", "[fast_solver]") {
-    // The fast solver's kernels read a float copy of the positions that its own update keeps current; every
-    // other move must reach it. The same actions on the textbook solver give the same bits.
+    // Every move made outside the fast solver's sweep must be what its next substep reads: the same actions
+    // on the textbook solver give the same bits. Each action comes where nothing else moves a particle.
     Scene scene = load_scene("drape-sphere");
     scene.cloth.rows = scene.cloth.cols = 24;
     scene.pins.particles = {{0, 0}};

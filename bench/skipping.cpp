@@ -151,7 +151,7 @@ int run_skipping(const SkippingOptions& o) {
             // 2. Bending stiffness 0 against no bending springs at all.
             {
                 Scene zero = hanging(size);
-                zero.settings.springs.bending = 0.0f;
+                zero.settings.springs.bending = glm::vec2(0.0f);
                 MassSpring b = build_simulation(zero);
                 MassSpring a = without_bending(b);
                 Pair p = time_pair([&] { a.run_steps(1); }, [&] { b.run_steps(1); }, o);

@@ -29,7 +29,10 @@ Scene scene_for(const Case& c, double h) {
     Scene s = load_scene("hanging");  // released flat, held by two corners: it moves from the first step
     s.cloth.rows = s.cloth.cols = c.grid;
     s.cloth.mass = c.mass;
-    s.settings.springs = {c.stiffness, 0.1f * c.stiffness, 0.025f * c.stiffness, c.damping};
+    s.settings.springs.structural = glm::vec2(c.stiffness);
+    s.settings.springs.shear = 0.1f * c.stiffness;
+    s.settings.springs.bending = glm::vec2(0.025f * c.stiffness);
+    s.settings.springs.damping = c.damping;
     s.settings.colliders.ground.enabled = false;
     s.settings.integration.integrator = c.integrator;
     s.settings.integration.dt = static_cast<float>(h);

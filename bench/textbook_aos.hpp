@@ -32,7 +32,8 @@ public:
     void step() {
         const float h = settings_.integration.dt / static_cast<float>(settings_.integration.substeps);
         const float c = settings_.springs.damping;
-        const float k[3] = {settings_.springs.structural, settings_.springs.shear, settings_.springs.bending};
+        // The textbook baseline is an isotropic per-spring cloth: one k per kind (the u-axis value).
+        const float k[3] = {settings_.springs.structural.x, settings_.springs.shear, settings_.springs.bending.x};
         for (Particle& p : particles_) p.force = glm::vec3(0.0f);
         for (const Spring& s : springs_) {
             Particle& a = particles_[s.a];

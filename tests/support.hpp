@@ -31,7 +31,7 @@ inline Scene chain(int particles, float spacing, float particle_mass, float k) {
     s.cloth.mass = particle_mass * static_cast<float>(particles);
     s.cloth.origin = {0.0f, 0.0f, 0.0f};
     s.pins.preset = PinPreset::None;
-    s.settings.springs = {k, 0.0f, 0.0f, 0.0f};
+    s.settings.springs = {glm::vec2(k), 0.0f, glm::vec2(0.0f), 0.0f};
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
     s.settings.colliders.ground.enabled = false;
     s.settings.integration.substeps = 1;

@@ -40,7 +40,7 @@ namespace clothsim {
 
 struct Energy {
     double kinetic = 0.0;            // J: sum of m v^2 / 2 with second-order velocities
-    double spring_potential = 0.0;   // J: sum of k (|d| - L0)^2 / 2
+    double spring_potential = 0.0;   // J: k w (|d| - L0)^2 / 2 over springs, k w |x_a - 2 x_m + x_b|^2 / 2 over bends
     double gravity_potential = 0.0;  // J: -sum of m g . x over free particles
     double contact_potential = 0.0;  // J: sum of k_c p^4 / (4 t^2) over contacts (penalty contact; else 0)
     double potential() const { return spring_potential + gravity_potential + contact_potential; }
@@ -80,6 +80,7 @@ public:
 
     std::size_t particle_count() const { return state_.size(); }
     std::size_t spring_count() const { return topology_.springs.size(); }
+    std::size_t bend_count() const { return topology_.bends.size(); }
     double time() const { return state_.time; }
     float rest_area() const { return rest_area_; }
 

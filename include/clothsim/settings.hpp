@@ -46,6 +46,20 @@ enum class ContactModel {
                  // forces the integrator sees (penalty_contact.hpp): gives the accuracy study a well-posed error
 };
 
+// The cloth's fabric in physical units, independent of the grid (material.hpp derives the per-spring values).
+// Used when `enabled`; otherwise cloth.mass and springs.structural/shear/bending describe the cloth.
+struct MaterialSettings {
+    bool enabled = false;
+    std::string preset;                    // "" or a name of material_presets(); fills the fields not set below
+    float density = 0.15f;                 // kg/m^2: areal density
+    glm::vec2 stretch{5000.0f, 5000.0f};   // N/m: membrane tensile stiffness along u_axis (warp), v_axis (weft)
+    float shear = 100.0f;                  // N/m: in-plane shear stiffness (per radian)
+    glm::vec2 bending{1e-5f, 1e-5f};       // N m: flexural rigidity per unit width, bending along u, along v
+    // Which fields the scene sets itself (bit per MaterialField); the others follow the preset.
+    unsigned explicit_fields = 0;
+    bool operator==(const MaterialSettings&) const = default;
+};
+
 struct ClothSettings {
     int rows = 32;                           // particles along v_axis (count)
     int cols = 32;                           // particles along u_axis (count)
@@ -57,10 +71,14 @@ struct ClothSettings {
     glm::vec3 velocity{0.0f, 0.0f, 0.0f};    // m/s: initial velocity of every free particle
 };
 
+// The stiffness every spring and bend uses, by kind and axis (spring.hpp). A per-spring scene sets them
+// directly; a material scene derives them from the fabric and the grid spacing (material.hpp).
 struct SpringSettings {
-    float structural = 400.0f;  // N/m: horizontal and vertical neighbours
-    float shear = 40.0f;        // N/m: both diagonals
-    float bending = 10.0f;      // N/m: two apart along rows and columns
+    glm::vec2 structural{400.0f, 400.0f};  // N/m: springs along u_axis, along v_axis
+    float shear = 40.0f;                   // N/m: both diagonals
+    // N/m along u_axis, along v_axis: skip-one springs' k (per-spring form), or bends' k = B h_v / h_u^3
+    // (material form; spring.hpp)
+    glm::vec2 bending{10.0f, 10.0f};
     float damping = 0.2f;       // 1/s: velocity damping rate c in x'' = a - c x'
     float strain_limit = 0.0f;  // fraction: 0 = off; otherwise no spring ends a substep longer than (1 + it) L0
     bool operator==(const SpringSettings&) const = default;
@@ -151,6 +169,10 @@ struct Scene {
     std::string name = "untitled";
     std::string description;
     ClothSettings cloth;
+    MaterialSettings material;
+    // Which per-spring fields (cloth.mass, springs.structural, springs.shear, springs.bending: bit per
+    // PerSpringField in material.hpp) the scene sets itself: a scene may not set them and [material] both.
+    unsigned per_spring_fields = 0;
     PinSpec pins;
     SimulationSettings settings;
 };

@@ -1,4 +1,6 @@
-// A Hooke spring between two particles: F = -k (|d| - L0) d/|d|, with k chosen by the spring's kind.
+// The elastic elements of a cloth: Hooke springs between two particles, and bends, the quadratic bending
+// of three consecutive particles on a grid line. Their stiffness lives in SpringSettings, by kind and axis,
+// so that changing it applies live, without rebuilding the element lists.
 #pragma once
 
 #include <cstdint>
@@ -8,19 +10,42 @@ namespace clothsim {
 enum class SpringKind : std::uint8_t {
     Structural = 0,  // horizontal and vertical neighbours
     Shear = 1,       // both diagonals of a grid cell
-    Bending = 2,     // two apart along rows and columns
+    Bending = 2,     // skip-one springs two apart along rows and columns, or bends (below)
 };
 inline constexpr int kSpringKindCount = 3;
 
 const char* to_string(SpringKind kind);
 
-// Topology only: which particles, how long at rest, which stiffness. Stiffness lives in SpringSettings so
-// that changing it applies live, without rebuilding the spring list.
+// The direction an element runs in on the grid: along u_axis (a row), along v_axis (a column), or across a
+// cell. Anisotropic fabric (warp and weft) has a stiffness per axis.
+enum class Axis : std::uint8_t { U = 0, V = 1, Diagonal = 2 };
+
+// A Hooke spring: F_a = k w (|d| - L0) d/|d| with d = x_b - x_a, k from the settings (kind, axis), w the
+// spring's weight. Topology only: which particles, how long at rest, which stiffness.
 struct Spring {
     std::uint32_t a = 0;
     std::uint32_t b = 0;
     float rest_length = 0.0f;  // m
     SpringKind kind = SpringKind::Structural;
+    Axis axis = Axis::U;
+    // The share of the cells around the spring the cloth has: 1 inside, 0.5 for a structural spring on the
+    // cloth's edge, which borders one cell instead of two (material form; always 1 in the per-spring form).
+    // A power of two, so k w is exact and every solver path rounds alike.
+    float weight = 1.0f;
+};
+
+// A bend: three consecutive particles a, m, b on a grid line, with the quadratic isometric bending energy
+// E = 0.5 k w |x_a - 2 x_m + x_b|^2 (Bergou, Wardetzky, Harmon, Zorin & Grinspun 2006, "A quadratic bending
+// model for inextensible surfaces", on a regular grid, where the discrete Laplacian along a line is the
+// second difference). For an inextensible line bent to curvature kappa, |x_a - 2 x_m + x_b| = h^2 kappa,
+// so k = B / h^2 per unit of the line's width gives the plate energy 0.5 B kappa^2 per area: the flexural
+// rigidity B (N m) is the same at every grid spacing. Forces are linear: F_a = F_b = -k w d, F_m = 2 k w d.
+struct Bend {
+    std::uint32_t a = 0;
+    std::uint32_t m = 0;
+    std::uint32_t b = 0;
+    Axis axis = Axis::U;
+    float weight = 1.0f;  // 0.5 on the cloth's edge rows and columns, which carry half a line's width
 };
 
 }  // namespace clothsim

@@ -49,8 +49,9 @@ struct Topology {
     int rows = 0;
     int cols = 0;
     std::vector<Spring> springs;
+    std::vector<Bend> bends;  // the material form's bending (kind Bending); the per-spring form has none
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
-    std::array<std::size_t, kSpringKindCount> spring_count_by_kind{};
+    std::array<std::size_t, kSpringKindCount> spring_count_by_kind{};  // bends count as Bending
 
     std::size_t index(int row, int col) const { return static_cast<std::size_t>(row) * cols + col; }
 };

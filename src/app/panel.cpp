@@ -4,6 +4,7 @@
 #include "app_state.hpp"
 #include "layout.hpp"
 
+#include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
 #include <imgui.h>
@@ -34,6 +35,7 @@ constexpr SliderHint kHints[] = {
     {"integration.tolerance", 1e-10f, 1e-2f, true}, {"springs.strain_limit", 0.0f, 1.0f, false},
     {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
     {"solver.sleep_time", 0.0f, 10.0f, false}, {"colliders.contact_stiffness", 10.0f, 1e6f, true},
+    {"material.density", 0.01f, 2.0f, true},  {"material.shear", 0.0f, 1e5f, true},
 };
 
 const SliderHint* hint_for(std::string_view name) {
@@ -130,8 +132,12 @@ bool value_widget(Scene& edit, const FieldInfo& f) {
             [&](float* v) { return float_widget(label, f, v); },
             [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
             [&](glm::vec2* v) {
-                return ImGui::DragFloat2(label.c_str(), &v->x, 0.01f, static_cast<float>(f.min),
-                                         static_cast<float>(f.max), "%.3g");
+                // Stiffnesses span decades: a drag moves them by a fraction of their size.
+                const bool stiffness = f.name == "material.stretch" || f.name == "material.bending" ||
+                                       f.name.starts_with("springs.");
+                const float speed = stiffness ? std::max(0.01f * std::max(v->x, v->y), 1e-9f) : 0.01f;
+                return ImGui::DragFloat2(label.c_str(), &v->x, speed, static_cast<float>(f.min),
+                                         static_cast<float>(f.max), "%.4g");
             },
             [&](glm::vec3* v) {
                 const float speed = std::max(0.005f, 0.01f * std::max({std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)}));
@@ -195,19 +201,90 @@ void keep_in_range(AppState& app, Scene& edit, const FieldInfo& f) {
     if (auto note = clamp_to_range(edit, f)) app.say(*note, true);
 }
 
+// After an edit of `f`: the material bookkeeping (material.hpp) and the springs it derives. A material the
+// grid cannot hold is left to the rebuild, which says why and keeps the running cloth.
+void note_edit(Scene& edit, const FieldInfo& f) {
+    note_field_set(edit, f.name);
+    try {
+        derive_springs(edit);
+    } catch (const SceneError&) {
+    }
+}
+
 // Draws every field of `edit` whose name starts with `prefix`; returns true when any changed.
 bool fields_section(Scene& edit, AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
-        if (!f.name.starts_with(prefix)) continue;
-        // Auto substeps owns the substeps field; greyed out so an edit is not silently overwritten.
-        const bool owned = app.stepper.policy().auto_substeps && f.name == "integration.substeps";
+        if (!f.name.starts_with(prefix) || f.name == "material.preset") continue;
+        // Auto substeps owns the substeps field, and a material the per-spring values: greyed out so an edit
+        // is not silently overwritten.
+        const bool owned = (app.stepper.policy().auto_substeps && f.name == "integration.substeps") ||
+                           (edit.material.enabled && !field_is_written(edit, f.name));
         if (owned) ImGui::BeginDisabled();
         if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
             keep_in_range(app, edit, f);
+            note_edit(edit, f);
             changed = true;
         }
+        if (owned && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled) && edit.material.enabled &&
+            !f.name.starts_with("integration.")) {
+            ImGui::SetTooltip("%s is derived from [material] on this grid", std::string(f.name).c_str());
+        }
         if (owned) ImGui::EndDisabled();
+    }
+    return changed;
+}
+
+// The fabric: per-spring values, a material of the scene's own, or a measured preset (material.hpp). A
+// choice rebuilds the cloth (masses change); the material's fields follow when it has one.
+bool material_section(Scene& edit, AppState& app) {
+    bool changed = false;
+    const MaterialSettings& m = edit.material;
+    const std::string current = !m.enabled ? "per spring" : m.preset.empty() ? "custom material" : m.preset;
+    if (ImGui::BeginCombo("fabric", current.c_str())) {
+        auto choose = [&](const std::string& name) {
+            if (name == "per spring") {
+                // Back to springs: the loaded scene's when it had them, else the built-in defaults.
+                const SpringSettings springs = app.loaded.material.enabled ? SpringSettings{} : app.loaded.settings.springs;
+                edit.settings.springs.structural = springs.structural;
+                edit.settings.springs.shear = springs.shear;
+                edit.settings.springs.bending = springs.bending;
+                edit.cloth.mass = app.loaded.material.enabled ? Scene{}.cloth.mass : app.loaded.cloth.mass;
+                edit.material.enabled = false;
+                edit.material.preset.clear();
+            } else {
+                edit.per_spring_fields = 0;
+                edit.material.enabled = true;
+                edit.material.preset = name == "custom material" ? "" : name;
+                note_edit(edit, *find_field("material.preset"));
+            }
+            changed = true;
+        };
+        for (const char* name : {"per spring", "custom material"}) {
+            if (ImGui::Selectable(name, current == name)) choose(name);
+        }
+        for (const MaterialPreset& p : material_presets()) {
+            const std::string name(p.name);
+            if (ImGui::Selectable(name.c_str(), current == name)) choose(name);
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(p.note).c_str());
+        }
+        ImGui::EndCombo();
+    }
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("per spring: cloth.mass and springs.* as numbers per spring (a finer grid is another "
+                          "fabric);\nmaterial: density, stretch, shear and bending in physical units, the same "
+                          "fabric at every resolution (docs/MATERIAL.md)");
+    }
+    if (edit.material.enabled) {
+        changed |= fields_section(edit, app, "material.");
+        try {
+            const SpringConstants k = spring_constants(edit.cloth, edit.material);
+            ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g, bends %.4g / %.4g N/m",
+                                k.structural.x, k.structural.y, k.shear, k.bending.x, k.bending.y);
+            ImGui::TextDisabled("Poisson ratio %.3f / %.3f", k.poisson_uv, k.poisson_vu);
+        } catch (const SceneError& e) {
+            ImGui::TextWrapped("%s", e.what());
+        }
     }
     return changed;
 }
@@ -542,6 +619,7 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     if (ImGui::CollapsingHeader("Cloth")) {
         ImGui::TextDisabled("changes rebuild the cloth");
         cloth_changed |= fields_section(edit, app, "cloth.");
+        cloth_changed |= material_section(edit, app);
         cloth_changed |= fields_section(edit, app, "pins");
     }
     if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(edit, app, "springs.");

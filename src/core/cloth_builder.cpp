@@ -1,6 +1,8 @@
 // The one cloth builder: a rows x cols grid placed by an origin and two in-plane axes, with structural,
-// shear and bending springs whose rest lengths are the initial distances.
+// shear and bending springs (or bends, with [material]) whose rest lengths are the initial distances.
 #include "clothsim/scene.hpp"
+
+#include "clothsim/material.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -9,34 +11,51 @@
 namespace clothsim {
 namespace {
 
-Topology grid_topology(int rows, int cols, const DVec3Array& position) {
+// Springs by kind and direction, and in the material form bends instead of skip-one bending springs, with
+// the weights of the cell-by-cell assembly (material.hpp): an edge's structural springs and bends carry half.
+Topology grid_topology(int rows, int cols, const DVec3Array& position, bool material) {
     Topology t;
     t.rows = rows;
     t.cols = cols;
-    auto add = [&](int r0, int c0, int r1, int c1, SpringKind kind) {
-        auto inside = [&](int r, int c) { return r >= 0 && r < rows && c >= 0 && c < cols; };
+    auto inside = [&](int r, int c) { return r >= 0 && r < rows && c >= 0 && c < cols; };
+    auto add = [&](int r0, int c0, int r1, int c1, SpringKind kind, Axis axis, float weight) {
         if (!inside(r0, c0) || !inside(r1, c1)) return;
         const auto a = static_cast<std::uint32_t>(t.index(r0, c0));
         const auto b = static_cast<std::uint32_t>(t.index(r1, c1));
         // The rest length in the spring kernels' arithmetic (float d, float length), so a spring at its start
         // length exerts exactly no force.
-        t.springs.push_back({a, b, glm::length(glm::vec3(position.get(b) - position.get(a))), kind});
+        t.springs.push_back({a, b, glm::length(glm::vec3(position.get(b) - position.get(a))), kind, axis, weight});
         ++t.spring_count_by_kind[static_cast<int>(kind)];
     };
+    auto add_bend = [&](int r0, int c0, int dr, int dc, Axis axis, float weight) {
+        if (!inside(r0, c0) || !inside(r0 + 2 * dr, c0 + 2 * dc)) return;
+        t.bends.push_back({static_cast<std::uint32_t>(t.index(r0, c0)), static_cast<std::uint32_t>(t.index(r0 + dr, c0 + dc)),
+                           static_cast<std::uint32_t>(t.index(r0 + 2 * dr, c0 + 2 * dc)), axis, weight});
+        ++t.spring_count_by_kind[static_cast<int>(SpringKind::Bending)];
+    };
+    // Half weight on the cloth's edge in the material form (a line there borders one cell, not two).
+    auto edge = [&](int i, int n) { return material && (i == 0 || i == n - 1) && n > 1 ? 0.5f : 1.0f; };
     // Grouped by kind and direction: each group is a set of parallel springs (the layout a fast solver
     // sweeps without two springs of a group writing one particle in the same sweep position).
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r, c + 1, SpringKind::Structural);
+        for (int c = 0; c < cols; ++c) add(r, c, r, c + 1, SpringKind::Structural, Axis::U, edge(r, rows));
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c, SpringKind::Structural);
+        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c, SpringKind::Structural, Axis::V, edge(c, cols));
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c + 1, SpringKind::Shear);
+        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c + 1, SpringKind::Shear, Axis::Diagonal, 1.0f);
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c + 1, r + 1, c, SpringKind::Shear);
-    for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r, c + 2, SpringKind::Bending);
-    for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r + 2, c, SpringKind::Bending);
+        for (int c = 0; c < cols; ++c) add(r, c + 1, r + 1, c, SpringKind::Shear, Axis::Diagonal, 1.0f);
+    if (material) {
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < cols; ++c) add_bend(r, c, 0, 1, Axis::U, edge(r, rows));
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < cols; ++c) add_bend(r, c, 1, 0, Axis::V, edge(c, cols));
+    } else {
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < cols; ++c) add(r, c, r, c + 2, SpringKind::Bending, Axis::U, 1.0f);
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < cols; ++c) add(r, c, r + 2, c, SpringKind::Bending, Axis::V, 1.0f);
+    }
 
     // Two triangles per cell, wound so their normal is u_axis x v_axis.
     for (int r = 0; r + 1 < rows; ++r) {
@@ -95,17 +114,34 @@ MassSpring build_simulation(const Scene& scene) {
             state.position.set(static_cast<std::size_t>(r) * cloth.cols + c, glm::dvec3(p));
         }
     }
-    const float particle_mass = cloth.mass / static_cast<float>(n);
-    state.mass.assign(n, particle_mass);
-    state.inverse_mass.assign(n, 1.0f / particle_mass);
+    if (scene.material.enabled) {
+        // Each cell's mass density x h_u x h_v goes a quarter to each corner (material.hpp).
+        const glm::dvec2 h = grid_spacing(cloth);
+        const double quarter = 0.25 * double(scene.material.density) * h.x * h.y;
+        state.mass.assign(n, 0.0f);
+        for (int r = 0; r < cloth.rows; ++r) {
+            for (int c = 0; c < cloth.cols; ++c) {
+                const int cells = (r > 0 ? 1 : 0) + (r + 1 < cloth.rows ? 1 : 0);
+                const int cells_across = (c > 0 ? 1 : 0) + (c + 1 < cloth.cols ? 1 : 0);
+                state.mass[static_cast<std::size_t>(r) * cloth.cols + c] = static_cast<float>(quarter * cells * cells_across);
+            }
+        }
+    } else {
+        state.mass.assign(n, cloth.mass / static_cast<float>(n));
+    }
+    state.inverse_mass.resize(n);
+    for (std::size_t i = 0; i < n; ++i) state.inverse_mass[i] = 1.0f / state.mass[i];
     state.pinned.assign(n, 0);
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {
         state.pinned[i] = 1;
         state.inverse_mass[i] = 0.0f;
     }
     std::vector<glm::vec3> velocity(n, cloth.velocity);
-    Topology topology = grid_topology(cloth.rows, cloth.cols, state.position);
-    return MassSpring(std::move(topology), std::move(state), scene.settings, velocity);
+    Topology topology = grid_topology(cloth.rows, cloth.cols, state.position, scene.material.enabled);
+    // The springs' k from the material here too, for a scene changed in code after it was loaded.
+    Scene derived = scene;
+    derive_springs(derived);
+    return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
 }
 
 }  // namespace clothsim

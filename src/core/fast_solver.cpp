@@ -17,6 +17,8 @@ namespace clothsim {
 namespace {
 
 constexpr int kPad = 2;  // zero columns each side of a stored spring row, so c - 2 and c + 1 are readable
+// Bit 3 of a sweep's mask: directions 4 and 5 are bends (the spring kinds take bits 0-2, step_plan.hpp).
+constexpr unsigned kBendsBit = 8u;
 
 struct Direction {
     int dr, dc;
@@ -117,6 +119,61 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) void spring_forces_avx512(c
     spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
+// Bend forces of one run of bends from i along `offset`: e = k float((x_i - x_m) + (x_b - x_m)), m = i + offset,
+// b = i + 2 offset, the second difference taken in double and rounded once, as the textbook's
+// bend_difference; the particles then get -e, 2 e, -e (row_force).
+[[gnu::always_inline]] inline void bend_forces_generic(const double* __restrict x, const double* __restrict y,
+                                                     const double* __restrict z, int offset, int begin, int end,
+                                                     float k, float* __restrict fx, float* __restrict fy,
+                                                     float* __restrict fz) {
+    for (int i = begin; i < end; ++i) {
+        const int m = i + offset, b = i + 2 * offset;
+        fx[i - begin] = k * static_cast<float>((x[i] - x[m]) + (x[b] - x[m]));
+        fy[i - begin] = k * static_cast<float>((y[i] - y[m]) + (y[b] - y[m]));
+        fz[i - begin] = k * static_cast<float>((z[i] - z[m]) + (z[b] - z[m]));
+    }
+}
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m128 second_difference4_avx2(const double* p, int i,
+                                                                                                  int offset) {
+    const __m256d m = _mm256_loadu_pd(p + i + offset);
+    return _mm256_cvtpd_ps(_mm256_add_pd(_mm256_sub_pd(_mm256_loadu_pd(p + i), m),
+                                         _mm256_sub_pd(_mm256_loadu_pd(p + i + 2 * offset), m)));
+}
+__attribute__((target("avx2,fma"))) void bend_forces_avx2(const double* x, const double* y, const double* z,
+                                                           int offset, int begin, int end, float k, float* fx,
+                                                           float* fy, float* fz) {
+    const __m256 vk = _mm256_set1_ps(k);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        float* out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        const double* p[3] = {x, y, z};
+        for (int c = 0; c < 3; ++c) {
+            const __m256 d = _mm256_insertf128_ps(_mm256_castps128_ps256(second_difference4_avx2(p[c], i, offset)),
+                                                  second_difference4_avx2(p[c], i + 4, offset), 1);
+            _mm256_storeu_ps(out[c], _mm256_mul_ps(vk, d));
+        }
+    }
+    bend_forces_generic(x, y, z, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(const double* x, const double* y,
+                                                                             const double* z, int offset, int begin,
+                                                                             int end, float k, float* fx, float* fy,
+                                                                             float* fz) {
+    const __m256 vk = _mm256_set1_ps(k);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        float* out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        const double* p[3] = {x, y, z};
+        for (int c = 0; c < 3; ++c) {
+            const __m512d m = _mm512_loadu_pd(p[c] + i + offset);
+            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_loadu_pd(p[c] + i), m),
+                                            _mm512_sub_pd(_mm512_loadu_pd(p[c] + i + 2 * offset), m));
+            _mm256_storeu_ps(out[c], _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
+        }
+    }
+    bend_forces_generic(x, y, z, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+}
+
 // Asked of the CPU once, on first use.
 FastKernel cpu_best_kernel() {
     static const FastKernel best = [] {
@@ -161,26 +218,49 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     // Missing springs keep rest length NaN until checked below; every in-grid slot must be filled by
     // exactly one spring for the sweep to be the same model as the spring list.
     for (auto& r : solver.rest_) r.assign(n, NAN);
+    std::array<std::vector<float>, 6> weight;
+    for (auto& w : weight) w.assign(n, 1.0f);
+    // Places the element from `start` along (dr, dc) in its direction; false when none fits or it is a duplicate.
+    auto place = [&](SpringKind kind, std::size_t start, int dr, int dc, float rest, float w) {
+        int exponent = 0;
+        if (w != 0.0f && std::frexp(w, &exponent) != 0.5f) return false;  // not a power of two: not exact
+        for (int d = 0; d < 6; ++d) {
+            const Direction& dir = kDirections[d];
+            if (dir.kind != kind || dir.dr != dr || dir.dc != dc) continue;
+            if (!std::isnan(solver.rest_[d][start])) return false;  // a duplicate
+            solver.rest_[d][start] = rest;
+            weight[d][start] = w;
+            solver.present_[d] = true;
+            return true;
+        }
+        return false;
+    };
+    auto grid_of = [&](std::uint32_t i) { return std::pair{static_cast<int>(i) / t.cols, static_cast<int>(i) % t.cols}; };
     for (const Spring& s : t.springs) {
         if (s.a >= n || s.b >= n) return std::nullopt;
-        const int ra = static_cast<int>(s.a) / t.cols, ca = static_cast<int>(s.a) % t.cols;
-        const int rb = static_cast<int>(s.b) / t.cols, cb = static_cast<int>(s.b) % t.cols;
-        bool placed = false;
-        for (int d = 0; d < 6 && !placed; ++d) {
-            const Direction& dir = kDirections[d];
-            if (dir.kind != s.kind) continue;
-            // Either end may be listed first.
-            for (const auto& [r0, c0, r1, c1, start] : {std::tuple{ra, ca, rb, cb, s.a}, std::tuple{rb, cb, ra, ca, s.b}}) {
-                if (r1 - r0 == dir.dr && c1 - c0 == dir.dc) {
-                    if (!std::isnan(solver.rest_[d][start])) return std::nullopt;  // a duplicate spring
-                    solver.rest_[d][start] = s.rest_length;
-                    solver.present_[d] = true;
-                    placed = true;
-                    break;
-                }
-            }
+        const auto [ra, ca] = grid_of(s.a);
+        const auto [rb, cb] = grid_of(s.b);
+        // Either end may be listed first.
+        if (!place(s.kind, s.a, rb - ra, cb - ca, s.rest_length, s.weight) &&
+            !place(s.kind, s.b, ra - rb, ca - cb, s.rest_length, s.weight)) {
+            return std::nullopt;
         }
-        if (!placed) return std::nullopt;
+    }
+    if (!t.bends.empty()) {
+        if (solver.present_[4] || solver.present_[5]) return std::nullopt;  // bending springs and bends both
+        solver.bends_ = true;
+    }
+    for (const Bend& b : t.bends) {
+        if (b.a >= n || b.m >= n || b.b >= n) return std::nullopt;
+        const auto [ra, ca] = grid_of(b.a);
+        const auto [rm, cm] = grid_of(b.m);
+        const auto [rb, cb] = grid_of(b.b);
+        // A bend is stored as its two-apart direction from a; its middle must lie halfway.
+        if (2 * rm != ra + rb || 2 * cm != ca + cb) return std::nullopt;
+        if (!place(SpringKind::Bending, b.a, rb - ra, cb - ca, 0.0f, b.weight) &&
+            !place(SpringKind::Bending, b.b, ra - rb, ca - cb, 0.0f, b.weight)) {
+            return std::nullopt;
+        }
     }
     for (int d = 0; d < 6; ++d) {
         const Direction& dir = kDirections[d];
@@ -192,6 +272,28 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
                 if (inside && solver.present_[d] && std::isnan(rest)) return std::nullopt;
                 if (!inside || !solver.present_[d]) rest = 0.0f;
             }
+        }
+        // The weights: the same along each row (scaling the row's k), or the same down each column (scaling
+        // the forces of those columns), for every element the direction has.
+        solver.row_weight_[d].assign(t.rows, 1.0f);
+        const int c0 = first_column(dir), c1 = end_column(dir, t.cols);
+        const int r1 = t.rows - dir.dr;
+        auto w = [&](int r, int c) { return weight[d][static_cast<std::size_t>(r) * t.cols + c]; };
+        bool by_row = true, by_column = true;
+        for (int r = 0; r < r1; ++r) {
+            for (int c = c0; c < c1; ++c) {
+                by_row = by_row && w(r, c) == w(r, c0);
+                by_column = by_column && w(r, c) == w(0, c);
+            }
+        }
+        if (by_row) {
+            for (int r = 0; r < r1 && c1 > c0; ++r) solver.row_weight_[d][r] = w(r, c0);
+        } else if (by_column) {
+            for (int c = c0; c < c1 && r1 > 0; ++c) {
+                if (w(0, c) != 1.0f) solver.column_weight_[d].emplace_back(c, w(0, c));
+            }
+        } else {
+            return std::nullopt;
         }
     }
     return solver;
@@ -205,8 +307,9 @@ int FastSolver::effective_threads(int requested) const {
     return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
 }
 
-void FastSolver::step(State& state, const SimulationSettings& settings, unsigned spring_mask,
-                      const Vec3Array* external, double h, std::vector<Box>* row_boxes) {
+void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
+                      double h, std::vector<Box>* row_boxes) {
+    const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
     // Buffers and the block layout are set up again only when the block count changes.
@@ -270,6 +373,8 @@ struct Grid {
     int rows, cols;
     const std::array<std::vector<float>, 6>& rest;
     const std::array<bool, 6>& present;
+    const std::array<std::vector<float>, 6>& row_weight;
+    const std::array<std::vector<std::pair<int, float>>, 6>& column_weight;
     std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
     // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
     std::size_t row_floats() const { return 18 * stride(); }
@@ -278,11 +383,13 @@ struct Grid {
 constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
 
 // Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
+// Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
 template <FastKernel K, unsigned Mask>
 [[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state, const SpringSettings& springs,
                                                    int r, float* out) {
     const std::size_t stride = grid.stride();
-    const float stiffness[3] = {springs.structural, springs.shear, springs.bending};
+    const float stiffness[6] = {springs.structural.x, springs.structural.y, springs.shear,
+                                springs.shear,        springs.bending.x,    springs.bending.y};
     for (int d = 0; d < 6; ++d) {
         const Direction& dir = kDirections[d];
         if (!kind_runs(Mask, dir.kind)) continue;
@@ -298,12 +405,21 @@ template <FastKernel K, unsigned Mask>
         }
         const int row_start = r * grid.cols;
         const int offset = dir.dr * grid.cols + dir.dc;
-        const float k = stiffness[static_cast<int>(dir.kind)];
+        const float k = stiffness[d] * grid.row_weight[d][r];
         const double* x = state.position.x.data();
         const double* y = state.position.y.data();
         const double* z = state.position.z.data();
         const int begin = row_start + c0, end = row_start + c1;
-        if constexpr (K == FastKernel::Avx512) {
+        if (d >= 4 && (Mask & kBendsBit)) {
+            const int half = offset / 2;  // a bend's middle is halfway along the two-apart direction
+            if constexpr (K == FastKernel::Avx512) {
+                bend_forces_avx512(x, y, z, half, begin, end, k, f + c0, f + stride + c0, f + 2 * stride + c0);
+            } else if constexpr (K == FastKernel::Avx2) {
+                bend_forces_avx2(x, y, z, half, begin, end, k, f + c0, f + stride + c0, f + 2 * stride + c0);
+            } else {
+                bend_forces_generic(x, y, z, half, begin, end, k, f + c0, f + stride + c0, f + 2 * stride + c0);
+            }
+        } else if constexpr (K == FastKernel::Avx512) {
             spring_forces_avx512(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
                                  f + 2 * stride + c0);
         } else if constexpr (K == FastKernel::Avx2) {
@@ -312,6 +428,9 @@ template <FastKernel K, unsigned Mask>
         } else {
             spring_forces_generic(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
                                   f + 2 * stride + c0);
+        }
+        for (const auto& [c, w] : grid.column_weight[d]) {
+            f[c] *= w, f[stride + c] *= w, f[2 * stride + c] *= w;
         }
     }
 }
@@ -329,7 +448,11 @@ template <unsigned Mask, bool Ext>
         f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];  // (+1,+1)
         f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];  // (+1,-1)
     }
-    if constexpr (kind_runs(Mask, SpringKind::Bending)) {
+    if constexpr (kind_runs(Mask, SpringKind::Bending) && (Mask & kBendsBit)) {
+        // Bends in the textbook's order, the one starting two before the particle first: -e, +2 e, -e.
+        f = ((f - f0[4 * D + c - 2]) + 2.0f * f0[4 * D + c - 1]) - f0[4 * D + c];  // along (0,+1)
+        f = ((f - f2[5 * D + c]) + 2.0f * f1[5 * D + c]) - f0[5 * D + c];          // along (+1,0)
+    } else if constexpr (kind_runs(Mask, SpringKind::Bending)) {
         f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];  // (0,+2)
         f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
     }
@@ -473,7 +596,7 @@ void sweep_generic(const SweepInput& in, State& state, int begin, int end) {
 using SpringRowFn = void (*)(const Grid&, const State&, const SpringSettings&, int, float*);
 using SweepFn = void (*)(const SweepInput&, State&, int, int);
 template <std::size_t... M>
-constexpr std::array<SpringRowFn, 8> spring_row_table(FastKernel kernel, std::index_sequence<M...>) {
+constexpr std::array<SpringRowFn, 16> spring_row_table(FastKernel kernel, std::index_sequence<M...>) {
     switch (kernel) {
         case FastKernel::Avx512: return {spring_row_avx512<M>...};
         case FastKernel::Avx2: return {spring_row_avx2<M>...};
@@ -482,7 +605,7 @@ constexpr std::array<SpringRowFn, 8> spring_row_table(FastKernel kernel, std::in
     return {spring_row_generic<M>...};
 }
 template <std::size_t... M>
-constexpr std::array<SweepFn, 8> sweep_table(FastKernel kernel, std::index_sequence<M...>) {
+constexpr std::array<SweepFn, 16> sweep_table(FastKernel kernel, std::index_sequence<M...>) {
     switch (kernel) {
         case FastKernel::Avx512: return {sweep_avx512<M>...};
         case FastKernel::Avx2: return {sweep_avx2<M>...};
@@ -494,16 +617,16 @@ constexpr std::array<SweepFn, 8> sweep_table(FastKernel kernel, std::index_seque
 }  // namespace
 
 void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
-    const Grid grid{rows_, cols_, rest_, present_};
-    spring_row_table(kernel_in_use(), std::make_index_sequence<8>())[mask & 7u](grid, state, springs, r, out);
+    const Grid grid{rows_, cols_, rest_, present_, row_weight_, column_weight_};
+    spring_row_table(kernel_in_use(), std::make_index_sequence<16>())[mask & 15u](grid, state, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
-    const Grid grid{rows_, cols_, rest_, present_};
+    const Grid grid{rows_, cols_, rest_, present_, row_weight_, column_weight_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
-    sweep_table(kernel_in_use(), std::make_index_sequence<8>())[sweep.mask & 7u](in, state, begin, end);
+    sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);
 }
 
 }  // namespace clothsim

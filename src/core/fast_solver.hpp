@@ -2,9 +2,13 @@
 //
 // Design (see docs/PERFORMANCE.md for the figures):
 //  - Springs of a grid come in six directions: structural (0,+1) (+1,0), shear (+1,+1) (+1,-1), bending
-//    (0,+2) (+2,0). The springs of one direction starting in one row are a contiguous run of particles
-//    paired with a shifted run, so their forces are computed by one vector loop (AVX2 + FMA when the CPU
-//    has it, chosen at run time; plain C++ otherwise) and each spring is computed once.
+//    (0,+2) (+2,0), where bending is either skip-one springs or bends (spring.hpp: the three particles
+//    from the start along (0,+1) or (+1,0)). The elements of one direction starting in one row are a
+//    contiguous run of particles paired with shifted runs, so their forces are computed by one vector loop
+//    (AVX-512 or AVX2 + FMA when the CPU has it, chosen at run time; plain C++ otherwise), each once.
+//  - Weights (spring.hpp) that vary by row scale the row's k; weights that vary by column scale the
+//    computed forces of those columns afterwards. Both are powers of two, so the result is the textbook's
+//    k w product bit for bit.
 //  - One pass over the rows does everything a substep needs. Row q's force is complete once the spring
 //    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
 //    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it in place
@@ -36,8 +40,9 @@ enum class FastKernel { Generic, Avx2, Avx512 };
 
 class FastSolver {
 public:
-    // Nullopt when the topology is not a rows x cols grid whose springs all run in the six directions, each
-    // direction either complete or absent (a cloth built without bending springs).
+    // Nullopt when the topology is not a rows x cols grid whose springs and bends all run in the six
+    // directions, each direction either complete or absent, with weights that vary only by row or only by
+    // column in each direction.
     static std::optional<FastSolver> for_topology(const Topology& topology);
 
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
@@ -81,6 +86,9 @@ private:
     int rows_, cols_;
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
+    bool bends_ = false;                       // directions 4 and 5 are bends, not skip-one springs
+    std::array<std::vector<float>, 6> row_weight_;                      // weight of direction d's springs in row r
+    std::array<std::vector<std::pair<int, float>>, 6> column_weight_;  // (column, weight) where not 1, every row
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

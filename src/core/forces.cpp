@@ -12,9 +12,8 @@ template <class T>
 void accumulate_spring_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
                               BasicVec3Array<T>& force) {
     using Vec = glm::vec<3, T>;
-    const std::array<T, kSpringKindCount> k = {springs.structural, springs.shear, springs.bending};
     for (const Spring& s : topology.springs) {
-        const T ks = k[static_cast<int>(s.kind)];
+        const T ks = stiffness_of(springs, s);
         if (ks == T(0)) continue;
         const Vec d(position.get(s.b) - position.get(s.a));  // the difference in double, rounded once to T
         const T rest = s.rest_length;
@@ -29,6 +28,14 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
         const Vec f = scale * d;
         force.add(s.a, f);
         force.add(s.b, -f);
+    }
+    for (const Bend& b : topology.bends) {
+        const T kb = stiffness_of(springs, b);
+        if (kb == T(0)) continue;
+        const Vec e = kb * Vec(bend_difference(position, b));  // the difference in double, rounded once to T
+        force.add(b.a, -e);
+        force.add(b.m, T(2) * e);
+        force.add(b.b, -e);
     }
 }
 
@@ -83,9 +90,13 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
                                const SpringSettings& springs) {
     double energy = 0.0;
     for (const Spring& s : topology.springs) {
-        const double k = stiffness_of(springs, s.kind);
+        const double k = stiffness_of(springs, s);
         const double stretch = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
         energy += 0.5 * k * stretch * stretch;
+    }
+    for (const Bend& b : topology.bends) {
+        const glm::dvec3 d = bend_difference(position, b);
+        energy += 0.5 * double(stiffness_of(springs, b)) * glm::dot(d, d);
     }
     return energy;
 }

@@ -6,7 +6,8 @@
 
 namespace clothsim {
 
-// Hooke springs, F_a = k (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b. A spring with L0 = 0 uses
+// Hooke springs, F_a = k w (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b; then the bends
+// (spring.hpp): with d = x_a - 2 x_m + x_b, F_a = F_b = -k w d and F_m = 2 k w d. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
 // d is taken in double and rounded once to the force type F; the rest is computed in F. Instantiated for
@@ -28,18 +29,30 @@ template <class F>
 void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
                             double rest_area, BasicVec3Array<F>& force);
 
-// Elastic energy 0.5 k (|d| - L0)^2 summed over springs (J).
+// Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends (J).
 double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs);
 
-// Spring stiffness for a kind (N/m).
-inline float stiffness_of(const SpringSettings& springs, SpringKind kind) {
+// Stiffness of a spring or bend of a kind along an axis (N/m), before its weight.
+inline float stiffness_of(const SpringSettings& springs, SpringKind kind, Axis axis) {
     switch (kind) {
-        case SpringKind::Structural: return springs.structural;
+        case SpringKind::Structural: return axis == Axis::V ? springs.structural.y : springs.structural.x;
         case SpringKind::Shear: return springs.shear;
-        case SpringKind::Bending: return springs.bending;
+        case SpringKind::Bending: return axis == Axis::V ? springs.bending.y : springs.bending.x;
     }
     return 0.0f;
+}
+// A spring's k w and a bend's k w: products with a power-of-two weight, exact in float.
+inline float stiffness_of(const SpringSettings& springs, const Spring& s) {
+    return stiffness_of(springs, s.kind, s.axis) * s.weight;
+}
+inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
+    return stiffness_of(springs, SpringKind::Bending, b.axis) * b.weight;
+}
+// The second difference x_a - 2 x_m + x_b of a bend, in double: (x_a - x_m) + (x_b - x_m).
+inline glm::dvec3 bend_difference(const DVec3Array& position, const Bend& b) {
+    const glm::dvec3 m = position.get(b.m);
+    return (position.get(b.a) - m) + (position.get(b.b) - m);
 }
 
 }  // namespace clothsim

@@ -17,7 +17,7 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
                            const Vec3Array& u, Vec3Array& out) {
     out.resize(u.size());
     for (const Spring& s : topology.springs) {
-        const float k = stiffness_of(springs, s.kind);
+        const float k = stiffness_of(springs, s);
         if (k == 0.0f) continue;
         const glm::vec3 d(position.get(s.b) - position.get(s.a));
         const float length = glm::length(d);
@@ -34,6 +34,15 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
         }
         out.add(s.a, f);
         out.add(s.b, -f);
+    }
+    // Bends are linear: K u = -k w (u_a - 2 u_m + u_b) on a and b, twice that with the sign flipped on m.
+    for (const Bend& b : topology.bends) {
+        const float k = stiffness_of(springs, b);
+        if (k == 0.0f) continue;
+        const glm::vec3 e = k * ((u.get(b.a) - u.get(b.m)) + (u.get(b.b) - u.get(b.m)));
+        out.add(b.a, -e);
+        out.add(b.m, 2.0f * e);
+        out.add(b.b, -e);
     }
 }
 

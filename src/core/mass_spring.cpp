@@ -50,6 +50,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     // The plan reads the counts; a hand-made topology may not have filled them in.
     topology_.spring_count_by_kind = {};
     for (const Spring& s : topology_.springs) ++topology_.spring_count_by_kind[static_cast<int>(s.kind)];
+    topology_.spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += topology_.bends.size();
     for (const auto& t : topology_.triangles) {
         const glm::dvec3 a = state_.position.get(t[0]);
         rest_area_ += static_cast<float>(
@@ -331,7 +332,7 @@ void MassSpring::grab(std::size_t i, glm::vec3 target) {
         // The cap: what stretches the particle's own springs by half their rest length, at least 10 m |g|.
         float springs = 0.0f;
         for (const Spring& s : topology_.springs) {
-            if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s.kind) * s.rest_length;
+            if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s) * s.rest_length;
         }
         const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
         grab_ = Grab{i, target, std::max(0.5f * springs, floor)};

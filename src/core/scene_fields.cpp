@@ -2,6 +2,7 @@
 // to_toml(), the README's field list and the panel's tooltips all read this table.
 #include "clothsim/scene.hpp"
 
+#include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
 #include <glm/geometric.hpp>
@@ -26,15 +27,21 @@ const std::array kFields = {
     FieldInfo{"cloth.rows", "", 1, 2048, "particles along v_axis (rows x cols <= 1048576)", [](Scene& s) -> FieldRef { return &s.cloth.rows; }},
     FieldInfo{"cloth.cols", "", 1, 2048, "particles along u_axis", [](Scene& s) -> FieldRef { return &s.cloth.cols; }},
     FieldInfo{"cloth.size", "m", 1e-3, 1e3, "[width along u_axis, height along v_axis]; one number for a square", [](Scene& s) -> FieldRef { return &s.cloth.size; }},
-    FieldInfo{"cloth.mass", "kg", 1e-6, 1e6, "total mass, shared equally by all particles", [](Scene& s) -> FieldRef { return &s.cloth.mass; }},
+    FieldInfo{"cloth.mass", "kg", 1e-6, 1e6, "total mass, shared equally by all particles (derived from material.density when the scene has [material])", [](Scene& s) -> FieldRef { return &s.cloth.mass; }},
     FieldInfo{"cloth.origin", "m", -kBig, kBig, "position of particle (row 0, col 0)", [](Scene& s) -> FieldRef { return &s.cloth.origin; }},
     FieldInfo{"cloth.u_axis", "", -1e3, 1e3, "direction of increasing column (normalised; not parallel to v_axis)", [](Scene& s) -> FieldRef { return &s.cloth.u_axis; }},
     FieldInfo{"cloth.v_axis", "", -1e3, 1e3, "direction of increasing row (normalised)", [](Scene& s) -> FieldRef { return &s.cloth.v_axis; }},
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
-    FieldInfo{"springs.structural", "N/m", 0, 1e9, "stiffness of horizontal and vertical neighbour springs", [](Scene& s) -> FieldRef { return &s.settings.springs.structural; }},
-    FieldInfo{"springs.shear", "N/m", 0, 1e9, "stiffness of diagonal springs", [](Scene& s) -> FieldRef { return &s.settings.springs.shear; }},
-    FieldInfo{"springs.bending", "N/m", 0, 1e9, "stiffness of springs two apart along rows and columns", [](Scene& s) -> FieldRef { return &s.settings.springs.bending; }},
+    FieldInfo{"material.preset", "", 0, 0, "a measured fabric (cotton, denim, silk, wool-jersey, polyester) that fills the material fields this scene does not set", [](Scene& s) -> FieldRef { return &s.material.preset; }},
+    FieldInfo{"material.density", "kg/m^2", 1e-3, 100, "areal density (mass per area)", [](Scene& s) -> FieldRef { return &s.material.density; }},
+    FieldInfo{"material.stretch", "N/m", 1e-2, 1e7, "membrane tensile stiffness (force per width per strain): one number, or [warp along u_axis, weft along v_axis]", [](Scene& s) -> FieldRef { return &s.material.stretch; }},
+    FieldInfo{"material.shear", "N/m", 0, 1e7, "in-plane shear stiffness (force per width per radian of shear)", [](Scene& s) -> FieldRef { return &s.material.shear; }},
+    FieldInfo{"material.bending", "N m", 0, 10, "flexural rigidity per unit width: one number, or [bending along u, along v]", [](Scene& s) -> FieldRef { return &s.material.bending; }},
+
+    FieldInfo{"springs.structural", "N/m", 0, 1e9, "stiffness of each horizontal and vertical neighbour spring: one number, or [along u_axis, along v_axis] (derived from [material] when the scene has one)", [](Scene& s) -> FieldRef { return &s.settings.springs.structural; }},
+    FieldInfo{"springs.shear", "N/m", 0, 1e9, "stiffness of each diagonal spring (derived from [material] when the scene has one)", [](Scene& s) -> FieldRef { return &s.settings.springs.shear; }},
+    FieldInfo{"springs.bending", "N/m", 0, 1e9, "stiffness of each spring two apart along rows and columns: one number, or [along u, along v] (with [material]: each bend's k = B h_v / h_u^3, derived)", [](Scene& s) -> FieldRef { return &s.settings.springs.bending; }},
     FieldInfo{"springs.damping", "1/s", 0, 1e4, "velocity damping rate c in x'' = a - c x' (independent of dt)", [](Scene& s) -> FieldRef { return &s.settings.springs.damping; }},
     FieldInfo{"springs.strain_limit", "", 0, 10, "0 = off; else Provot's limit: no spring ends a substep longer than (1 + this) x its rest length (0.1 = 10%)", [](Scene& s) -> FieldRef { return &s.settings.springs.strain_limit; }},
 
@@ -173,7 +180,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
             [&](const int* v) { return std::to_string(*v); },
             [&](const float* v) { return number(*v); },
             [&](const bool* v) { return std::string(*v ? "true" : "false"); },
-            [&](const glm::vec2* v) { return cat("[", number(v->x), ", ", number(v->y), "]"); },
+            [&](const glm::vec2* v) { return v->x == v->y ? number(v->x) : cat("[", number(v->x), ", ", number(v->y), "]"); },
             [&](const glm::vec3* v) { return cat("[", number(v->x), ", ", number(v->y), ", ", number(v->z), "]"); },
             [&](const std::string* v) { return quoted(*v); },
             [&](const PinSpec* v) {
@@ -221,6 +228,8 @@ void validate(const Scene& scene) {
     if (glm::length(glm::cross(c.u_axis / lu, c.v_axis / lv)) < 1e-3f) {
         throw SceneError("cloth.u_axis and cloth.v_axis are parallel; allowed: two non-parallel directions");
     }
+    if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
+    if (scene.material.enabled) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive
     const ColliderSettings& colliders = scene.settings.colliders;
     if (colliders.contact == ContactModel::Penalty && !(colliders.thickness > 0.0f)) {
         throw SceneError("colliders.thickness = " + format_value(scene, *find_field("colliders.thickness")) +

@@ -3,6 +3,7 @@
 #include "clothsim/scene.hpp"
 
 #include "clothsim/data_dirs.hpp"
+#include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
 #include <toml++/toml.h>
@@ -278,6 +279,7 @@ void load_table(Scene& scene, const toml::table& table, const std::string& prefi
                 throw SceneError(where(source, node) + ": " + name + " = " + show(node) + " is not allowed; allowed: " +
                                  describe_allowed(*field));
             }
+            note_field_set(scene, name);
         } else if (is_section(name)) {
             const toml::table* sub = node.as_table();
             if (!sub) {
@@ -308,6 +310,7 @@ Scene parse_scene(std::string_view toml_text, std::string_view source_name) {
     load_table(scene, table, "", source_name);
     try {
         validate(scene);
+        derive_springs(scene);
     } catch (const SceneError& e) {
         // Cross-field messages start with the field they blame ("pins: ...", "cloth.u_axis and ..."): point
         // at that field's line when the file sets it.
@@ -399,8 +402,10 @@ void apply_override(Scene& scene, std::string_view assignment) {
         throw SceneError(source + ": " + key + " = " + show(node) + " is not allowed; allowed: " +
                          describe_allowed(*field));
     }
+    note_field_set(candidate, key);
     try {
         validate(candidate);
+        derive_springs(candidate);
     } catch (const SceneError& e) {
         throw SceneError(source + ": " + e.what());
     }
@@ -409,21 +414,28 @@ void apply_override(Scene& scene, std::string_view assignment) {
 
 std::string to_toml(const Scene& scene) {
     std::string out = "# clothsim scene (fields, units and ranges: README.md, \"Scene files\")\n";
+    // In the material form the per-spring fields are derived: shown as comments, not read back.
+    auto line = [&](const FieldInfo& f, std::string_view key) -> std::string {
+        const std::string text = std::string(key) + " = " + format_value(scene, f);
+        if (field_is_written(scene, f.name)) return text + "\n";
+        if (!f.name.starts_with("material.")) return "# " + text + "  (derived from [material] on this grid)\n";
+        return "";
+    };
     for (const FieldInfo& f : scene_fields()) {
-        if (f.name.find('.') == std::string_view::npos) {
-            out += std::string(f.name) + " = " + format_value(scene, f) + "\n";
-        }
+        if (f.name.find('.') == std::string_view::npos) out += line(f, f.name);
     }
     std::string section;
     for (const FieldInfo& f : scene_fields()) {
         const auto dot = f.name.rfind('.');
         if (dot == std::string_view::npos) continue;
+        const std::string text = line(f, f.name.substr(dot + 1));
+        if (text.empty()) continue;
         const std::string s(f.name.substr(0, dot));
         if (s != section) {
             section = s;
             out += "\n[" + section + "]\n";
         }
-        out += std::string(f.name.substr(dot + 1)) + " = " + format_value(scene, f) + "\n";
+        out += text;
     }
     return out;
 }

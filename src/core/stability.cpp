@@ -74,9 +74,16 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     }
     std::vector<double> row_sum(state.size(), 0.0);
     for (const Spring& s : topology.springs) {
-        const double k = stiffness_of(settings.springs, s.kind);
+        const double k = stiffness_of(settings.springs, s);
         row_sum[s.a] += 2.0 * k;
         row_sum[s.b] += 2.0 * k;
+    }
+    // A bend's Hessian k w [1 -2 1]^T [1 -2 1] (x I): absolute row sums 4 k w on a and b, 8 k w on m.
+    for (const Bend& b : topology.bends) {
+        const double k = stiffness_of(settings.springs, b);
+        row_sum[b.a] += 4.0 * k;
+        row_sum[b.m] += 8.0 * k;
+        row_sum[b.b] += 4.0 * k;
     }
     double gershgorin = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
@@ -84,7 +91,9 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         gershgorin = std::max(gershgorin, (row_sum[i] + contact_k) / state.mass[i]);
     }
     const SpringSettings& k = settings.springs;
-    const double sum_k = double(k.structural) + double(k.shear) + double(k.bending);
+    // A line of springs k has w^2 up to 4 k / m, a line of bends up to 16 k / m (the symbol (2 - 2 cos)^2).
+    const double bending = std::max(k.bending.x, k.bending.y) * (topology.bends.empty() ? 1.0 : 4.0);
+    const double sum_k = double(std::max(k.structural.x, k.structural.y)) + double(k.shear) + bending;
     limit.omega_gershgorin = std::sqrt(gershgorin);
     limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest) : 0.0;
     const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
@@ -134,7 +143,7 @@ double max_strain(const MassSpring& sim) {
     for (const Spring& s : sim.topology().springs) {
         if (s.rest_length == 0.0f) continue;
         if (grabbed && (s.a == *grabbed || s.b == *grabbed)) continue;  // the user's pull, not a blow-up
-        if (stiffness_of(sim.settings().springs, s.kind) == 0.0f) continue;  // exerts no force: not a spring
+        if (stiffness_of(sim.settings().springs, s) == 0.0f) continue;  // exerts no force: not a spring
         const double length = glm::length(glm::dvec3(sim.position(s.b)) - glm::dvec3(sim.position(s.a)));
         if (!std::isfinite(length)) return std::numeric_limits<double>::infinity();
         worst = std::max(worst, length / s.rest_length - 1.0);

@@ -49,9 +49,11 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
         plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::Fast
                                                                                  : StepPath::Textbook;
     }
-    const float k[kSpringKindCount] = {settings.springs.structural, settings.springs.shear, settings.springs.bending};
+    const SpringSettings& springs = settings.springs;
+    const bool k[kSpringKindCount] = {springs.structural != glm::vec2(0.0f), springs.shear != 0.0f,
+                                      springs.bending != glm::vec2(0.0f)};
     for (int kind = 0; kind < kSpringKindCount; ++kind) {
-        plan.springs[kind] = k[kind] != 0.0f && topology.spring_count_by_kind[kind] > 0;
+        plan.springs[kind] = k[kind] && topology.spring_count_by_kind[kind] > 0;
     }
     plan.wind = wind_active(settings.forces);
     const ColliderSettings& c = settings.colliders;

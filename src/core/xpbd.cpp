@@ -24,7 +24,7 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     // One Gauss-Seidel pass over the springs; with lambda starting at 0 each substep,
     // d_lambda = -C / (w_a + w_b + 1 / (k h^2)).
     for (const Spring& s : topology.springs) {
-        const double k = stiffness_of(springs, s.kind);
+        const double k = stiffness_of(springs, s);
         if (k == 0.0) continue;
         const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
         const glm::dvec3 d = state.position.get(s.b) - state.position.get(s.a);
@@ -34,6 +34,17 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         const double lambda = -(length - s.rest_length) / (wa + wb + 1.0 / (k * h * h));
         state.position.add(s.a, -wa * lambda * normal);
         state.position.add(s.b, wb * lambda * normal);
+    }
+    // Bends: the vector constraint C = x_a - 2 x_m + x_b with compliance 1 / (k h^2) and gradients I, -2 I, I:
+    // d_lambda = -C / (w_a + 4 w_m + w_b + 1 / (k h^2)).
+    for (const Bend& b : topology.bends) {
+        const double k = stiffness_of(springs, b);
+        if (k == 0.0) continue;
+        const double wa = state.inverse_mass[b.a], wm = state.inverse_mass[b.m], wb = state.inverse_mass[b.b];
+        const glm::dvec3 lambda = -bend_difference(state.position, b) / (wa + 4.0 * wm + wb + 1.0 / (k * h * h));
+        state.position.add(b.a, wa * lambda);
+        state.position.add(b.m, -2.0 * wm * lambda);
+        state.position.add(b.b, wb * lambda);
     }
     for (std::size_t i = 0; i < n; ++i) {
         state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));

@@ -20,14 +20,14 @@ struct Session {
     Scene edited, loaded;
     MassSpring sim;
     Session() : edited(load_scene("hanging")), loaded(edited), sim(build_simulation(edited)) {
-        edited.settings.springs.structural = 123.0f;  // the user's edit, not yet saved
+        edited.settings.springs.structural = glm::vec2(123.0f);  // the user's edit, not yet saved
         sim.run_steps(3);
     }
 };
 
 void check_untouched(const Session& s, const std::vector<glm::vec3>& positions, double time) {
-    CHECK(s.edited.settings.springs.structural == 123.0f);
-    CHECK(s.loaded.settings.springs.structural == 400.0f);
+    CHECK(s.edited.settings.springs.structural.x == 123.0f);
+    CHECK(s.loaded.settings.springs.structural.x == 400.0f);
     CHECK(s.edited.name == "hanging");
     CHECK(s.sim.positions() == positions);
     CHECK(s.sim.time() == time);
@@ -88,14 +88,14 @@ TEST_CASE("running_scene: a panel change reaches the next substep and is what Sa
     MassSpring weightless = sim;
     SimulationSettings edit = sim.settings();
     edit.forces.gravity = {0.0f, -1.62f, 0.0f};  // the Moon
-    edit.springs.structural = 250.0f;
+    edit.springs.structural = glm::vec2(250.0f);
     sim.apply(edit);
     CHECK(sim.settings().forces.gravity.y == -1.62f);
     test::edit_settings(weightless, [](SimulationSettings& s) {
         s.forces.gravity = glm::vec3(0.0f);
-        s.springs.structural = 250.0f;
+        s.springs.structural = glm::vec2(250.0f);
     });
-    test::edit_settings(earth, [](SimulationSettings& s) { s.springs.structural = 250.0f; });
+    test::edit_settings(earth, [](SimulationSettings& s) { s.springs.structural = glm::vec2(250.0f); });
 
     // The next substep runs with it: against the same cloth without gravity, a free corner has fallen in
     // proportion to g (the first substep is linear in gravity).
@@ -115,6 +115,6 @@ TEST_CASE("running_scene: a panel change reaches the next substep and is what Sa
     const Scene saved = load_scene(path.string());
     std::filesystem::remove(path);
     CHECK(saved.settings == sim.settings());
-    CHECK(saved.settings.springs.structural == 250.0f);
+    CHECK(saved.settings.springs.structural.x == 250.0f);
     CHECK(saved.cloth.rows == document.cloth.rows);
 }

@@ -44,7 +44,7 @@ TEST_CASE("forces Hooke spring pulls a stretched spring together with k (|d| - L
     Topology t;
     t.springs = {{0, 1, 1.0f, SpringKind::Shear}};
     const State st = two_particles({0.0f, 0.0f, 0.0f}, {0.0f, 3.0f, 4.0f});  // |d| = 5
-    SpringSettings k{100.0f, 7.0f, 1.0f, 0.0f};
+    SpringSettings k{glm::vec2(100.0f), 7.0f, glm::vec2(1.0f), 0.0f};
     Vec3Array f;
     f.resize(2);
     accumulate_spring_forces(t, st.position, k, f);

@@ -71,7 +71,7 @@ TEST_CASE("grab a hard drag of curtain pulls the cloth along: no guard retry, bo
 TEST_CASE("grab a drag with structural and shear at 0, and of a 2048 x 1 chain, never trips the guard", "[grab]") {
     SECTION("bending springs only") {
         Scene scene = load_scene("curtain");
-        scene.settings.springs.structural = 0.0f;
+        scene.settings.springs.structural = glm::vec2(0.0f);
         scene.settings.springs.shear = 0.0f;
         MassSpring sim = build_simulation(scene);
         const Drag d = drag(sim, sim.particle_count() / 2, {0.0f, 0.0f, 1.5f}, 6, 30);

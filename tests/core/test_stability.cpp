@@ -28,7 +28,7 @@ Scene free_grid(int n, float k) {
     s.cloth.rows = n;
     s.cloth.cols = n;
     s.pins.preset = PinPreset::None;
-    s.settings.springs = {k, 0.1f * k, 0.025f * k, 0.0f};
+    s.settings.springs = {glm::vec2(k), 0.1f * k, glm::vec2(0.025f * k), 0.0f};
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
     s.settings.colliders.ground.enabled = false;
     s.settings.integration.substeps = 1;
@@ -146,7 +146,7 @@ TEST_CASE("stability plane-wave bound on a grid is 4 (k_struct + k_shear + k_ben
     const SpringSettings& k = s.settings.springs;
     const double m = sim.state().mass[0];
     REQUIRE(m == Approx(0.5 / 256.0).epsilon(1e-6));
-    const double sum_k = double(k.structural) + double(k.shear) + double(k.bending);
+    const double sum_k = double(k.structural.x) + double(k.shear) + double(k.bending.x);
 
     const StabilityLimit limit = stability_limit(sim);
     CHECK(limit.omega_plane_wave * limit.omega_plane_wave == Approx(4.0 * sum_k / m).epsilon(1e-9));
@@ -918,7 +918,7 @@ TEST_CASE("stability damping limits the explicit parts of XPBD and RK4, and auto
 TEST_CASE("stability the guard never raises substeps beyond what a scene file may hold", "[stability]") {
     Scene s = load_scene("hanging");
     s.cloth.rows = s.cloth.cols = 4;
-    s.settings.springs.structural = 1e9f;
+    s.settings.springs.structural = glm::vec2(1e9f);
     s.cloth.mass = 0.005f;
     s.settings.integration.substeps = 8000;
     MassSpring sim = build_simulation(s);

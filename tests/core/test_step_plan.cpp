@@ -58,13 +58,13 @@ Scene small_hanging(SolverMethod method, int n = 12) {
     return s;
 }
 
-float& stiffness(SpringSettings& springs, SpringKind kind) {
+// Turns a kind off (both axes).
+void switch_off(SpringSettings& springs, SpringKind kind) {
     switch (kind) {
-        case SpringKind::Structural: return springs.structural;
-        case SpringKind::Shear: return springs.shear;
-        case SpringKind::Bending: return springs.bending;
+        case SpringKind::Structural: springs.structural = glm::vec2(0.0f); break;
+        case SpringKind::Shear: springs.shear = 0.0f; break;
+        case SpringKind::Bending: springs.bending = glm::vec2(0.0f); break;
     }
-    return springs.bending;
 }
 
 const StageStatus& status_of(const std::vector<StageStatus>& statuses, Stage stage) {
@@ -81,7 +81,7 @@ TEST_CASE("step_plan a spring kind with stiffness 0 moves the cloth bit for bit 
         for (SpringKind kind : {SpringKind::Structural, SpringKind::Shear, SpringKind::Bending}) {
             INFO(method_name(method) << " solver, " << to_string(kind) << " springs");
             Scene scene = small_hanging(method);
-            stiffness(scene.settings.springs, kind) = 0.0f;
+            switch_off(scene.settings.springs, kind);
             MassSpring with_kind = build_simulation(scene);
             Topology without = with_kind.topology();
             std::erase_if(without.springs, [&](const Spring& s) { return s.kind == kind; });
@@ -120,7 +120,7 @@ TEST_CASE("step_plan fast and textbook solvers agree bit for bit for every set o
                 step_n(sim, before);
                 test::edit_settings(sim, [&](SimulationSettings& s) {
                     for (SpringKind kind : {SpringKind::Structural, SpringKind::Shear, SpringKind::Bending}) {
-                        if (!((mask >> static_cast<int>(kind)) & 1u)) stiffness(s.springs, kind) = 0.0f;
+                        if (!((mask >> static_cast<int>(kind)) & 1u)) switch_off(s.springs, kind);
                     }
                 });
                 sim.step();  // the plan follows the settings from this step on
@@ -315,7 +315,7 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
 TEST_CASE("step_plan a setting applied to a live simulation replans at the point of change", "[step_plan]") {
     MassSpring sim = build_simulation(small_hanging(SolverMethod::Fast));
     REQUIRE(sim.plan().springs[2]);
-    test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.bending = 0.0f; });
+    test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.bending = glm::vec2(0.0f); });
     CHECK_FALSE(sim.plan().springs[2]);  // at once, not at the next step
     sim.step();
     CHECK_FALSE(sim.plan().springs[2]);
@@ -339,7 +339,7 @@ TEST_CASE("step_plan describe lists every stage once and names the setting that 
     for (SolverMethod method : kMethods) {
         INFO(method_name(method) << " solver");
         Scene scene = small_hanging(method);
-        scene.settings.springs.bending = 0.0f;
+        scene.settings.springs.bending = glm::vec2(0.0f);
         scene.settings.forces.wind = glm::vec3(0.0f);
         scene.settings.springs.strain_limit = 0.0f;
         scene.settings.forces.max_speed = 0.0f;
@@ -396,7 +396,8 @@ TEST_CASE("step_plan describe lists every stage once and names the setting that 
     CHECK(status_of(statuses, Stage::Sleep).state == StageState::Skipped);
     CHECK(status_of(statuses, Stage::Sleep).note.find("forces.wind") != std::string::npos);
     // No spring kind at all: the springs stage is skipped, and says why.
-    settings.springs.structural = settings.springs.shear = 0.0f;
+    settings.springs.structural = glm::vec2(0.0f);
+    settings.springs.shear = 0.0f;
     const MassSpring none(no_bending, sim.state(), settings);
     const std::vector<StageStatus> none_statuses = describe(none.plan(), none.topology(), none.settings());
     const StageStatus& springs = status_of(none_statuses, Stage::Springs);
@@ -502,9 +503,9 @@ TEST_CASE("step_plan describe and the profile agree on which stages ran", "[step
 TEST_CASE("step_plan the textbook path does not time the spring stage when every spring kind is skipped",
           "[step_plan]") {
     Scene scene = small_hanging(SolverMethod::Textbook);
-    scene.settings.springs.structural = 0.0f;
+    scene.settings.springs.structural = glm::vec2(0.0f);
     scene.settings.springs.shear = 0.0f;
-    scene.settings.springs.bending = 0.0f;
+    scene.settings.springs.bending = glm::vec2(0.0f);
     MassSpring sim = build_simulation(scene);
     REQUIRE_FALSE(sim.plan().any_springs());
     sim.run_steps(1);

@@ -1,0 +1,179 @@
+#include "clothsim/material.hpp"
+
+#include "clothsim/scene.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+namespace clothsim {
+namespace {
+
+// Measured fabrics. Every number and its source: docs/MATERIAL.md, "Presets".
+// clang-format off
+constexpr std::array kPresets = {
+    MaterialPreset{"cotton", 0.124f, {4033.0f, 4070.0f}, 105.0f, {1.16e-5f, 1.16e-5f},
+                   "cotton broadcloth (density, bending: Matsudaira et al. 2015); stretch, shear of a 65/35 "
+                   "cotton/polyester shirting (Wang et al. 2011)"},
+    MaterialPreset{"denim", 0.324f, {8891.0f, 8891.0f}, 122.5f, {1.69e-5f, 1.69e-5f},
+                   "KES-F of denim sample A (Kumari & Khurana 2016: stretch as the 0-500 gf/cm secant, shear, "
+                   "bending); density of an 11 oz denim (Wang et al. 2011)"},
+    MaterialPreset{"silk", 0.104f, {86.0f, 343.0f}, 14.3f, {1.86e-6f, 1.86e-6f},
+                   "stand-in, no silk data found: polyester faille (density, bending: Matsudaira et al. 2015), "
+                   "a light polyester (stretch, shear: Wang et al. 2011)"},
+    MaterialPreset{"wool-jersey", 0.187f, {33.0f, 69.0f}, 37.0f, {7.7e-6f, 4.8e-6f},
+                   "stand-in, no wool jersey data found: a cotton/polyester interlock knit (Wang et al. 2011)"},
+    MaterialPreset{"polyester", 0.117f, {4004.0f, 4055.0f}, 19.2f, {7.55e-6f, 7.55e-6f},
+                   "polyester tropical (density, bending: Matsudaira et al. 2015); stretch, shear of a 100% "
+                   "polyester (Wang et al. 2011)"},
+};
+// clang-format on
+
+struct FieldBit {
+    std::string_view name;
+    unsigned bit;
+};
+constexpr std::array<FieldBit, 4> kMaterialFields = {{{"material.density", kMaterialDensity},
+                                                      {"material.stretch", kMaterialStretch},
+                                                      {"material.shear", kMaterialShear},
+                                                      {"material.bending", kMaterialBending}}};
+constexpr std::array<FieldBit, 4> kPerSpringFields = {{{"cloth.mass", kClothMass},
+                                                       {"springs.structural", kSpringsStructural},
+                                                       {"springs.shear", kSpringsShear},
+                                                       {"springs.bending", kSpringsBending}}};
+
+void apply_preset(MaterialSettings& m) {
+    const MaterialPreset* p = find_material_preset(m.preset);
+    if (!p) return;
+    if (!(m.explicit_fields & kMaterialDensity)) m.density = p->density;
+    if (!(m.explicit_fields & kMaterialStretch)) m.stretch = p->stretch;
+    if (!(m.explicit_fields & kMaterialShear)) m.shear = p->shear;
+    if (!(m.explicit_fields & kMaterialBending)) m.bending = p->bending;
+}
+
+std::string show(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", v);
+    return buffer;
+}
+
+std::string join(const std::array<FieldBit, 4>& fields, unsigned bits) {
+    std::string s;
+    for (const FieldBit& f : fields) {
+        if (bits & f.bit) s += (s.empty() ? "" : ", ") + std::string(f.name);
+    }
+    return s;
+}
+
+}  // namespace
+
+std::span<const MaterialPreset> material_presets() { return kPresets; }
+
+const MaterialPreset* find_material_preset(std::string_view name) {
+    for (const MaterialPreset& p : kPresets) {
+        if (p.name == name) return &p;
+    }
+    return nullptr;
+}
+
+glm::dvec2 grid_spacing(const ClothSettings& cloth) {
+    return {cloth.cols > 1 ? double(cloth.size.x) / (cloth.cols - 1) : 0.0,
+            cloth.rows > 1 ? double(cloth.size.y) / (cloth.rows - 1) : 0.0};
+}
+
+SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSettings& material) {
+    if (cloth.rows < 2 || cloth.cols < 2) {
+        throw SceneError("cloth.rows = " + std::to_string(cloth.rows) + ", cloth.cols = " + std::to_string(cloth.cols) +
+                         " has no cells for [material] to fill; allowed with [material]: at least 2 x 2 particles");
+    }
+    const glm::dvec2 h = grid_spacing(cloth);
+    const double hu = h.x, hv = h.y;
+    const double su = material.stretch.x, sv = material.stretch.y, g = material.shear;
+    SpringConstants out;
+    // Uniaxial stiffness along u is C11 - G^2 / C22 and along v C22 - G^2 / C11 (C12 = G). Both equal to the
+    // targets: C11 C22 - G^2 = su C22 = sv C11, so C11 = r C22 with r = su / sv, and r C22^2 - su C22 - G^2 = 0.
+    const double r = su / sv;
+    const double c22 = (su + std::sqrt(su * su + 4.0 * r * g * g)) / (2.0 * r);
+    const double c11 = r * c22;
+    const double au = c11 - g * (hu / hv) * (hu / hv);
+    const double av = c22 - g * (hv / hu) * (hv / hu);
+    if (au < 0.0 || av < 0.0) {
+        throw SceneError("material.shear = " + show(g) + " N/m is too large for material.stretch = [" + show(su) + ", " +
+                         show(sv) + "] N/m on cells of " + show(hu) + " x " + show(hv) +
+                         " m: the diagonal springs alone would be stiffer in tension; allowed: a smaller shear, or "
+                         "cells closer to square (cloth.size / (cloth.cols - 1, cloth.rows - 1))");
+    }
+    out.structural = {au * hv / hu, av * hu / hv};
+    out.shear = g * (hu * hu + hv * hv) / (2.0 * hu * hv);
+    out.bending = {double(material.bending.x) * hv / (hu * hu * hu), double(material.bending.y) * hu / (hv * hv * hv)};
+    out.poisson_uv = g / c22;
+    out.poisson_vu = g / c11;
+    out.total_mass = double(material.density) * double(cloth.size.x) * double(cloth.size.y);
+    return out;
+}
+
+void note_field_set(Scene& scene, std::string_view field) {
+    MaterialSettings& m = scene.material;
+    if (field == "material.preset") {
+        m.enabled = true;
+        apply_preset(m);
+        return;
+    }
+    for (const FieldBit& f : kMaterialFields) {
+        if (field == f.name) {
+            m.enabled = true;
+            m.explicit_fields |= f.bit;
+            return;
+        }
+    }
+    for (const FieldBit& f : kPerSpringFields) {
+        if (field == f.name) scene.per_spring_fields |= f.bit;
+    }
+}
+
+void derive_springs(Scene& scene) {
+    if (!scene.material.enabled || !material_clash(scene).empty()) return;
+    const SpringConstants k = spring_constants(scene.cloth, scene.material);
+    SpringSettings& s = scene.settings.springs;
+    s.structural = glm::vec2(k.structural);
+    s.shear = static_cast<float>(k.shear);
+    s.bending = glm::vec2(k.bending);
+    scene.cloth.mass = static_cast<float>(k.total_mass);
+}
+
+std::string material_clash(const Scene& scene) {
+    const MaterialSettings& m = scene.material;
+    if (!m.preset.empty() && !find_material_preset(m.preset)) {
+        std::string names;
+        for (const MaterialPreset& p : kPresets) names += (names.empty() ? "" : ", ") + std::string(p.name);
+        return "material.preset = \"" + m.preset + "\" is not a known fabric; allowed: " + names;
+    }
+    if (!m.enabled || scene.per_spring_fields == 0) return "";
+    std::string material_fields = m.preset.empty() ? "" : "material.preset";
+    if (const std::string set = join(kMaterialFields, m.explicit_fields); !set.empty()) {
+        material_fields += (material_fields.empty() ? "" : ", ") + set;
+    }
+    return "material: " + join(kPerSpringFields, scene.per_spring_fields) + " and " + material_fields +
+           " both describe the cloth's mass and stiffness; allowed: one form, either [material] (density, stretch, "
+           "shear, bending in physical units) or cloth.mass with springs.structural/shear/bending (per spring)";
+}
+
+bool field_is_written(const Scene& scene, std::string_view field) {
+    const MaterialSettings& m = scene.material;
+    if (field.starts_with("material.")) {
+        if (!m.enabled) return false;
+        if (field == "material.preset") return !m.preset.empty();
+        for (const FieldBit& f : kMaterialFields) {
+            if (field == f.name) return m.preset.empty() || (m.explicit_fields & f.bit);
+        }
+        return true;
+    }
+    if (m.enabled) {
+        for (const FieldBit& f : kPerSpringFields) {
+            if (field == f.name) return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace clothsim

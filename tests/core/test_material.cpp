@@ -1,0 +1,353 @@
+// The material form: a fabric in physical units is the same cloth at every grid resolution.
+#include "clothsim/material.hpp"
+#include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+using namespace clothsim;
+
+namespace {
+
+// The heavy elastica: B theta'' = -q (L - s) cos(theta), theta(0) = 0, theta'(L) = 0, q = density g. Solved by
+// shooting on theta'(0) (bisection; the residual theta'(L) grows with it) with RK4 in s; returns the tip drop
+// integral of sin(theta) ds.
+double elastica_tip_drop(double length, double bending, double q) {
+    const int n = 4000;
+    const double ds = length / n;
+    auto shoot = [&](double kappa0, double* drop) {
+        double theta = 0.0, kappa = kappa0, y = 0.0;
+        auto f = [&](double s, double th, double ka) {
+            return std::array<double, 3>{ka, -q / bending * (length - s) * std::cos(th), std::sin(th)};
+        };
+        for (int i = 0; i < n; ++i) {
+            const double s = i * ds;
+            const auto k1 = f(s, theta, kappa);
+            const auto k2 = f(s + ds / 2, theta + ds / 2 * k1[0], kappa + ds / 2 * k1[1]);
+            const auto k3 = f(s + ds / 2, theta + ds / 2 * k2[0], kappa + ds / 2 * k2[1]);
+            const auto k4 = f(s + ds, theta + ds * k3[0], kappa + ds * k3[1]);
+            theta += ds / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
+            kappa += ds / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
+            y += ds / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
+        }
+        if (drop) *drop = y;
+        return kappa;  // theta'(L)
+    };
+    double lo = 0.0, hi = q * length * length / bending;  // theta'(L) < 0 at lo, > 0 at the linear moment bound
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (shoot(mid, nullptr) < 0.0 ? lo : hi) = mid;
+    }
+    double drop = 0.0;
+    shoot(0.5 * (lo + hi), &drop);
+    return drop;
+}
+
+// A strip `length` x `width` lying flat along x in the horizontal plane, clamped at x = 0 by its first two
+// columns of particles, settled under gravity; its tip's mean drop (m).
+// The clamp line lies `clamp_back` spacings behind column 1: halfway between the two pinned columns (0.5) is
+// where the discrete clamp holds the strip (docs/MATERIAL.md: second-order convergence there, first order at
+// column 0 or 1). `springs` puts the bends' k on skip-one springs instead (the per-spring form's model).
+double cantilever_drop(int along, double length, double width, double bending, double clamp_back, bool springs) {
+    Scene s;
+    const double h = length / (along - 1 - clamp_back);
+    s.cloth.cols = along;
+    s.cloth.rows = static_cast<int>(std::lround(width / h)) + 1;
+    s.cloth.size = {static_cast<float>(h * (along - 1)), static_cast<float>(width)};
+    s.cloth.origin = {static_cast<float>(-clamp_back * h), 1.0f, 0.0f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    s.pins.preset = PinPreset::None;
+    for (int r = 0; r < s.cloth.rows; ++r) s.pins.particles.push_back({r, 0}), s.pins.particles.push_back({r, 1});
+    s.settings.colliders.ground.enabled = false;
+    // Mass-proportional damping at critical for the first mode, w1 = 3.516 sqrt(B / (density L^4)) (9 rad/s at
+    // B = 1e-4 N m, 91 at 1e-2), settles the strip to e^-20 in 20 / w1; it does not change the static shape.
+    const double w1 = 3.516 * std::sqrt(bending / (0.15 * std::pow(length, 4)));
+    s.settings.springs.damping = static_cast<float>(2.0 * w1);
+    s.settings.solver.sleep_speed = 0.0f;
+    s.material.enabled = true;
+    s.material.density = 0.15f;
+    s.material.stretch = glm::vec2(1000.0f);
+    s.material.shear = 100.0f;
+    s.material.bending = glm::vec2(static_cast<float>(bending));
+    if (springs) {
+        // The per-spring form with the bends' k on skip-one springs.
+        derive_springs(s);
+        s.material.enabled = false;
+    }
+    MassSpring sim = build_simulation(s);
+    const StabilityLimit limit = stability_limit(sim);
+    sim.set_substeps(auto_substeps(limit, s.settings.integration.dt, 0.8f, 1));
+    sim.run_steps(static_cast<long long>(std::ceil(20.0 / w1 / s.settings.integration.dt)));
+    double drop = 0.0;
+    for (int r = 0; r < s.cloth.rows; ++r) drop += 1.0 - sim.state().position.y[static_cast<std::size_t>(r) * along + along - 1];
+    return drop / s.cloth.rows;
+}
+
+}  // namespace
+
+TEST_CASE("material: a clamped strip's tip drop matches the heavy elastica within 3% at 33 particles and 1.5% at "
+          "65, converging", "[material]") {
+    // The strip: 0.1 m x 0.025 m, density 0.15 kg/m^2, B = 1e-4 N m, stretch 1000 N/m (strain 1.5e-4 at
+    // this load: inextensible).
+    const double q = 0.15 * 9.81;
+    const double exact = elastica_tip_drop(0.1, 1e-4, q);
+    // Large deflection: the linear formula q L^4 / 8B would say 0.184 m, more than the strip's length.
+    REQUIRE(exact == Approx(0.0783).epsilon(0.01));
+    const double coarse = cantilever_drop(33, 0.1, 0.025, 1e-4, 0.5, false);
+    const double fine = cantilever_drop(65, 0.1, 0.025, 1e-4, 0.5, false);
+    INFO("elastica " << exact << " m; 33 particles " << coarse << ", 65 particles " << fine);
+    CHECK(std::abs(coarse / exact - 1.0) < 0.03);
+    CHECK(std::abs(fine / exact - 1.0) < 0.015);
+    CHECK(std::abs(fine - exact) < std::abs(coarse - exact));
+}
+
+TEST_CASE("material: a stiff clamped strip's tip drop matches the small-deflection w L^4 / 8B", "[material]") {
+    const double q = 0.15 * 9.81, b = 1e-2;
+    const double linear = q * std::pow(0.1, 4) / (8.0 * b);
+    REQUIRE(elastica_tip_drop(0.1, b, q) == Approx(linear).epsilon(1e-3));  // the elastica agrees here
+    const double coarse = cantilever_drop(33, 0.1, 0.025, b, 0.5, false);
+    const double fine = cantilever_drop(65, 0.1, 0.025, b, 0.5, false);
+    INFO("w L^4 / 8B = " << linear << " m; 33 particles " << coarse << ", 65 particles " << fine);
+    CHECK(std::abs(coarse / linear - 1.0) < 0.03);
+    CHECK(std::abs(fine / linear - 1.0) < 0.015);
+    CHECK(std::abs(fine - linear) < std::abs(coarse - linear));
+}
+
+// The study behind the choice of bends over skip-one springs (docs/MATERIAL.md): run with
+//   build/release/tests/test_core "material study*"
+TEST_CASE("material study: bends and skip-one springs against the elastica", "[material][.study]") {
+    const double q = 0.15 * 9.81;
+    for (double b : {1e-4, 1e-2}) {
+        const double exact = elastica_tip_drop(0.1, b, q);
+        std::printf("B = %g N m: elastica tip drop %.6g m (small-deflection formula %.6g)\n", b, exact,
+                    q * 1e-4 / (8 * b));
+        for (int n : {17, 33, 65}) {
+            for (double back : {0.0, 0.5, 1.0}) {
+                const double drop = cantilever_drop(n, 0.1, 0.025, b, back, false);
+                std::printf("  %3d particles, clamp line %.1f spacings behind column 1, bends: %.6g (%+.3f%%)\n", n,
+                            back, drop, 100 * (drop / exact - 1));
+            }
+            const double drop = cantilever_drop(n, 0.1, 0.025, b, 0.5, true);
+            std::printf("  %3d particles, skip-one springs with the bends' k:         %.6g (%+.3f%%)\n", n, drop,
+                        100 * (drop / exact - 1));
+        }
+    }
+}
+
+namespace {
+
+struct Tensile {
+    double stiffness;  // N/m: force per width per strain, from the stored energy 0.5 S strain^2 W L
+    double poisson;    // contraction of the width at mid-length per strain
+};
+
+// A square sheet with `per_side` particles a side, no gravity, held by its first and last columns (along
+// u) or rows (along v); the far one moved out by `strain`, settled; its stiffness from the elastic energy.
+Tensile tensile_test(int per_side, bool along_u, glm::vec2 stretch, float shear) {
+    Scene s;
+    const float side = 0.3f;
+    s.cloth.rows = s.cloth.cols = per_side;
+    s.cloth.size = {side, side};
+    s.cloth.origin = {0.0f, 0.0f, 0.0f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 1.0f, 0.0f};
+    s.pins.preset = along_u ? PinPreset::LeftEdge : PinPreset::TopRow;
+    s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
+    s.settings.colliders.ground.enabled = false;
+    s.settings.solver.sleep_speed = 0.0f;
+    s.material.enabled = true;
+    s.material.density = 0.15f;
+    s.material.stretch = stretch;
+    s.material.shear = shear;
+    s.material.bending = glm::vec2(1e-5f);
+    MassSpring sim = build_simulation(s);
+    // The far edge pinned too, moved out by the strain.
+    const double strain = 1e-3;
+    for (int i = 0; i < per_side; ++i) {
+        const std::size_t p = along_u ? static_cast<std::size_t>(i) * per_side + per_side - 1
+                                      : static_cast<std::size_t>(per_side - 1) * per_side + i;
+        sim.set_pinned(p, true);
+        glm::vec3 x = sim.position(p);
+        (along_u ? x.x : x.y) *= static_cast<float>(1.0 + strain);
+        sim.move_pinned(p, x);
+    }
+    // The slowest in-plane mode, w ~ pi sqrt(S / density) / side (1900 rad/s at 5000 N/m), damped at
+    // critical and settled to e^-20.
+    const double w = 3.14159 * std::sqrt(std::min(stretch.x, stretch.y) / 0.15) / side;
+    SimulationSettings settings = sim.settings();
+    settings.springs.damping = static_cast<float>(2.0 * w);
+    sim.apply(settings);
+    sim.set_substeps(auto_substeps(stability_limit(sim), settings.integration.dt, 0.8f, 1));
+    sim.run_steps(static_cast<long long>(std::ceil(20.0 / w / settings.integration.dt)));
+    Tensile out{};
+    out.stiffness = 2.0 * sim.energy().spring_potential / (strain * strain * side * side);
+    // Width at mid-length, across the middle column (along u) or row (along v).
+    const int mid = per_side / 2;
+    auto at = [&](int r, int c) { return sim.state().position.get(static_cast<std::size_t>(r) * per_side + c); };
+    const double width = along_u ? at(per_side - 1, mid).y - at(0, mid).y : at(mid, per_side - 1).x - at(mid, 0).x;
+    out.poisson = -(width / side - 1.0) / strain;
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("material: a sheet pulled along warp or weft has force per width per strain = material.stretch within 2% "
+          "at 16, 32 and 64 particles a side", "[material]") {
+    const glm::vec2 stretch{5000.0f, 2000.0f};
+    const float shear = 100.0f;
+    for (int n : {16, 32, 64}) {
+        for (bool along_u : {true, false}) {
+            const Tensile t = tensile_test(n, along_u, stretch, shear);
+            const double target = along_u ? stretch.x : stretch.y;
+            // The lattice's Poisson ratio C12 / C22 (material.hpp), measured at mid-length: the held edges keep
+            // their width, so the middle of a square contracts a little less than a long strip would.
+            Scene probe;
+            probe.cloth.rows = probe.cloth.cols = n;
+            probe.cloth.size = {0.3f, 0.3f};
+            probe.material.stretch = stretch;
+            probe.material.shear = shear;
+            const SpringConstants k = spring_constants(probe.cloth, probe.material);
+            const double poisson = along_u ? k.poisson_uv : k.poisson_vu;
+            INFO(n << " a side, along " << (along_u ? "u" : "v") << ": " << t.stiffness << " N/m against " << target
+                   << "; Poisson " << t.poisson << " against " << poisson);
+            CHECK(std::abs(t.stiffness / target - 1.0) < 0.02);
+            CHECK(t.poisson > 0.5 * poisson);
+            CHECK(t.poisson < 1.05 * poisson);
+        }
+    }
+}
+
+TEST_CASE("material: spring constants reproduce the stretch, shear and bending the material asks for", "[material]") {
+    Scene s;
+    s.cloth.rows = 21;
+    s.cloth.cols = 41;
+    s.cloth.size = {1.0f, 0.5f};  // square cells of 0.025 m
+    s.material.stretch = {4000.0f, 1000.0f};
+    s.material.shear = 50.0f;
+    s.material.bending = {2e-5f, 1e-5f};
+    const SpringConstants k = spring_constants(s.cloth, s.material);
+    const double h = 0.025;
+    // Square cells: the diagonals give C11 = C22 = C12 = C66 = k_d = G; a_u = k_u.
+    CHECK(k.shear == Approx(50.0));
+    const double c11 = k.structural.x + k.shear, c22 = k.structural.y + k.shear, c12 = k.shear;
+    CHECK(c11 - c12 * c12 / c22 == Approx(4000.0).epsilon(1e-9));
+    CHECK(c22 - c12 * c12 / c11 == Approx(1000.0).epsilon(1e-9));
+    CHECK(k.poisson_uv == Approx(c12 / c22));
+    // A bend of k = B h_v / h_u^3 stores 0.5 B kappa^2 h_u h_v at |x_a - 2 x_m + x_b| = h^2 kappa.
+    CHECK(k.bending.x == Approx(2e-5 / (h * h)).epsilon(1e-5));
+    CHECK(k.bending.y == Approx(1e-5 / (h * h)).epsilon(1e-5));
+    CHECK(k.total_mass == Approx(0.15 * 0.5).epsilon(1e-6));
+
+    // Non-square cells: the same stretch and shear through other spring constants.
+    s.cloth.rows = 11;  // 0.05 m along v, 0.025 m along u
+    const SpringConstants r = spring_constants(s.cloth, s.material);
+    const double hu = 0.025, hv = 0.05;
+    const double C11 = r.structural.x * hu / hv + 50.0 * (hu / hv) * (hu / hv);
+    const double C22 = r.structural.y * hv / hu + 50.0 * (hv / hu) * (hv / hu);
+    CHECK(C11 - 2500.0 / C22 == Approx(4000.0).epsilon(1e-9));
+    CHECK(C22 - 2500.0 / C11 == Approx(1000.0).epsilon(1e-9));
+    CHECK(r.shear * 2.0 * hu * hv / (hu * hu + hv * hv) == Approx(50.0));
+    CHECK(r.bending.x == Approx(2e-5 * hv / (hu * hu * hu)).epsilon(1e-5));
+    CHECK(r.bending.y == Approx(1e-5 * hu / (hv * hv * hv)).epsilon(1e-5));
+
+    // A shear the diagonals of long thin cells cannot give without a negative structural spring: refused.
+    s.cloth.rows = 3;
+    s.material.shear = 3000.0f;
+    CHECK_THROWS_WITH(spring_constants(s.cloth, s.material), Catch::Contains("material.shear"));
+    s.cloth.rows = 1;
+    CHECK_THROWS_WITH(spring_constants(s.cloth, s.material), Catch::Contains("at least 2 x 2"));
+}
+
+TEST_CASE("material: each particle carries a quarter of each cell around it; the cloth weighs density x area",
+          "[material]") {
+    Scene s = parse_scene("[cloth]\nrows = 5\ncols = 9\nsize = [0.8, 0.4]\n[material]\ndensity = 0.2\n", "t.toml");
+    const MassSpring sim = build_simulation(s);
+    const auto& m = sim.state().mass;
+    const double cell = 0.2 * 0.1 * 0.1;
+    CHECK(m[0] == Approx(cell / 4));         // corner
+    CHECK(m[1] == Approx(cell / 2));         // edge
+    CHECK(m[9 + 1] == Approx(cell));         // inside
+    CHECK(m[4 * 9 + 8] == Approx(cell / 4));  // the far corner
+    double total = 0.0;
+    for (float x : m) total += x;
+    CHECK(total == Approx(0.2 * 0.8 * 0.4).epsilon(1e-6));
+    CHECK(s.cloth.mass == Approx(0.2f * 0.8f * 0.4f));  // cloth.mass shows the derived total
+    CHECK(sim.bend_count() == 5 * 7 + 9 * 3);
+    for (const Spring& spring : sim.topology().springs) CHECK(spring.kind != SpringKind::Bending);
+}
+
+TEST_CASE("material: a preset fills the fields a scene does not set, in any order, and --set takes a preset",
+          "[material]") {
+    const MaterialPreset* denim = find_material_preset("denim");
+    REQUIRE(denim);
+    for (const char* text : {"[material]\npreset = \"denim\"\nbending = 3e-5\n", "[material]\nbending = 3e-5\npreset = \"denim\"\n"}) {
+        const Scene s = parse_scene(text, "t.toml");
+        CHECK(s.material.enabled);
+        CHECK(s.material.density == denim->density);
+        CHECK(s.material.stretch == denim->stretch);
+        CHECK(s.material.shear == denim->shear);
+        CHECK(s.material.bending == glm::vec2(3e-5f));
+    }
+    // A per-spring scene that does not set its per-spring fields itself takes a preset from --set.
+    Scene bundled = parse_scene("name = \"x\"\n", "t.toml");
+    apply_override(bundled, "material.preset=silk");
+    CHECK(bundled.material.density == find_material_preset("silk")->density);
+    const MassSpring sim = build_simulation(bundled);
+    CHECK(sim.bend_count() > 0);
+    // Another preset later keeps the explicit field.
+    apply_override(bundled, "material.stretch=[900, 300]");
+    apply_override(bundled, "material.preset=cotton");
+    CHECK(bundled.material.stretch == glm::vec2(900.0f, 300.0f));
+    CHECK(bundled.material.density == find_material_preset("cotton")->density);
+    // Every preset builds and steps.
+    for (const MaterialPreset& p : material_presets()) {
+        Scene s = load_scene("hanging");
+        s.per_spring_fields = 0;
+        apply_override(s, "material.preset=" + std::string(p.name));
+        MassSpring run = build_simulation(s);
+        run.set_substeps(auto_substeps(stability_limit(run), s.settings.integration.dt, 0.8f, 1));
+        run.run_steps(10);
+        INFO(p.name);
+        CHECK(run.all_finite());
+    }
+}
+
+TEST_CASE("material: a scene that sets both forms is refused with the fields that clash", "[material]") {
+    CHECK_THROWS_WITH(parse_scene("[cloth]\nmass = 0.3\n[springs]\nshear = 10\n[material]\npreset = \"denim\"\n", "a.toml"),
+                      Catch::Contains("a.toml:") && Catch::Contains("cloth.mass, springs.shear") &&
+                          Catch::Contains("material.preset"));
+    Scene material = parse_scene("[material]\nstretch = 3000\n", "b.toml");
+    CHECK_THROWS_WITH(apply_override(material, "springs.structural=5000"),
+                      Catch::Contains("--set springs.structural=5000") && Catch::Contains("springs.structural") &&
+                          Catch::Contains("material.stretch"));
+    CHECK(material.per_spring_fields == 0);  // a refused --set changes nothing
+    Scene per_spring = parse_scene("[springs]\nbending = 4\n", "c.toml");
+    CHECK_THROWS_WITH(apply_override(per_spring, "material.density=0.2"), Catch::Contains("springs.bending"));
+    CHECK_THROWS_WITH(parse_scene("[material]\npreset = \"tweed\"\n", "d.toml"),
+                      Catch::Contains("d.toml:2") && Catch::Contains("cotton, denim, silk, wool-jersey, polyester"));
+    // Damping and the strain limit combine with either form.
+    CHECK_NOTHROW(parse_scene("[springs]\ndamping = 1.0\nstrain_limit = 0.1\n[material]\npreset = \"silk\"\n", "e.toml"));
+}
+
+TEST_CASE("material: a scene written out reads back the same, with the derived per-spring values as comments",
+          "[material]") {
+    const Scene s = parse_scene("[cloth]\nrows = 12\ncols = 12\n[material]\npreset = \"wool-jersey\"\nshear = 20\n", "t.toml");
+    const std::string text = to_toml(s);
+    INFO(text);
+    CHECK(text.find("preset = \"wool-jersey\"") != std::string::npos);
+    CHECK(text.find("\nshear = 20.0") != std::string::npos);
+    CHECK(text.find("density =") == std::string::npos);  // follows the preset
+    CHECK(text.find("# structural = ") != std::string::npos);
+    CHECK(text.find("# mass = ") != std::string::npos);
+    const Scene back = parse_scene(text, "back.toml");
+    CHECK(back.material == s.material);
+    CHECK(back.settings.springs == s.settings.springs);
+    CHECK(back.cloth.mass == s.cloth.mass);
+    CHECK(to_toml(back) == text);
+    // A per-spring scene writes no [material].
+    CHECK(to_toml(parse_scene("[springs]\nshear = 9\n", "p.toml")).find("[material]") == std::string::npos);
+}

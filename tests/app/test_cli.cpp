@@ -108,6 +108,10 @@ TEST_CASE("cli: --headless --json prints only a JSON report on stdout") {
     CHECK(std::isfinite(j.at("kinetic_energy").get<double>()));
     CHECK(std::isfinite(j.at("potential_energy").get<double>()));
     CHECK(j.at("kinetic_energy").get<double>() >= 0.0);
+    // A draped cloth is stretched a little, not torn apart (6.5% measured).
+    REQUIRE(j.at("max_strain").is_number());
+    CHECK(j.at("max_strain").get<double>() > 0.0);
+    CHECK(j.at("max_strain").get<double>() < 0.2);
 }
 
 TEST_CASE("cli: --set changes the scene that is run") {
@@ -337,6 +341,7 @@ TEST_CASE("cli: a simulation that blows up exits 3 and reports finite false") {
         CHECK(j.at("steps").get<long long>() >= 1);
         CHECK(j.at("steps").get<long long>() < 50);
         CHECK(j.at("kinetic_energy").is_null());
+        CHECK(j.at("max_strain").is_null());
         CHECK_THAT(r.err, Contains("non-finite"));
     }
 }

@@ -90,6 +90,9 @@ std::vector<std::string> bundled_scene_names();
 
 // Largest grid accepted (particles); larger grids are rejected with a message, not attempted.
 inline constexpr long long kMaxParticles = 1024LL * 1024LL;
+// Largest clip radius in pins (m), and the allowed radii as messages and the README state them.
+inline constexpr double kMaxPinRadius = 1.0;
+std::string describe_pin_radius();
 
 // ---- Building. ----
 // Pinned particle indices (row-major) for a cloth; throws SceneError for a pin outside the grid.

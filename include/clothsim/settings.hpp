@@ -95,10 +95,21 @@ struct ForceSettings {
     bool operator==(const ForceSettings&) const = default;
 };
 
-// Which particles are pinned: a named preset and/or explicit (row, col) pairs.
+// One pin: the particle (row, col) alone, or a clip that holds every particle whose rest position lies within
+// `radius` of that particle's (a real cloth is held by a clip of finite size; a single pinned particle is a
+// point load whose strain grows without bound as the grid is refined).
+struct PinClip {
+    int row = 0;
+    int col = 0;
+    float radius = 0.0f;  // m: 0 = this particle only
+    bool operator==(const PinClip&) const = default;
+};
+
+// Which particles are pinned: a named preset and/or explicit pins.
 struct PinSpec {
     PinPreset preset = PinPreset::TopCorners;
-    std::vector<std::pair<int, int>> particles;  // (row, col), in addition to the preset
+    std::vector<PinClip> particles;  // in addition to the preset
+    float preset_radius = 0.0f;      // m: each pin of the preset is a clip of this radius (0 = point pins)
     bool operator==(const PinSpec&) const = default;
 };
 

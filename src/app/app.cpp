@@ -181,10 +181,11 @@ Ray cursor_ray(const AppState& app, const Window& window, float scale) {
 void pins_to_scene(AppState& app) {
     const int cols = app.sim.topology().cols;  // the running cloth, even if an edit of the grid failed to rebuild
     app.scene.pins.preset = PinPreset::None;
+    app.scene.pins.preset_radius = 0.0f;
     app.scene.pins.particles.clear();
-    for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {
+    for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
         if (app.sim.state().pinned[i]) {
-            app.scene.pins.particles.emplace_back(static_cast<int>(i) / cols, static_cast<int>(i) % cols);
+            app.scene.pins.particles.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols});
         }
     }
 }

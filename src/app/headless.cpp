@@ -5,6 +5,7 @@
 #include "clothsim/stability.hpp"
 #include "clothsim/step_plan.hpp"
 #include "clothsim/stepper.hpp"
+#include "clothsim/strain.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -148,7 +149,7 @@ int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutco
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 // One JSON object: the scene, what ran (the substeps in force at the end: auto substeps' choice or the
-// guard's), energies and the step profile.
+// guard's), energies, the largest membrane strain and the step profile.
 void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit) {
     const Energy e = sim.energy();
     const std::vector<StageStatus> stages = describe(sim.plan(), sim.topology(), sim.settings());
@@ -168,6 +169,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"kinetic_energy", finite_or_null(e.kinetic)},
         {"potential_energy", finite_or_null(e.potential())},
         {"total_energy", finite_or_null(e.total())},
+        {"max_strain", finite_or_null(max_membrane_strain(sim.topology(), sim.state().position))},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
     std::cout << out.dump(2) << std::endl;

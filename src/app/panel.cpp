@@ -101,12 +101,15 @@ bool float_widget(const std::string& label, const FieldInfo& f, float* v) {
     return ImGui::DragFloat(label.c_str(), v, speed, static_cast<float>(f.min), static_cast<float>(f.max), "%.4g");
 }
 
-// The pins: a preset picked in a combo (which drops the particles pinned by hand).
+// The pins: a preset picked in a combo (which drops the particles pinned by hand and keeps the preset's clip
+// radius). The preview shows the clip radius and how many pins were added by hand ("top-corners, clip 0.03 m + 2").
 bool pin_combo(const std::string& label, PinSpec* v) {
     const int preset = static_cast<int>(v->preset);
     const auto names = pin_preset_names();
-    const std::string preview =
-        std::string(names[preset]) + (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
+    char clip[48] = "";
+    if (v->preset_radius > 0.0f) std::snprintf(clip, sizeof clip, ", clip %.3g m", v->preset_radius);
+    const std::string preview = std::string(names[preset]) + clip +
+                                (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
     bool edited = false;
     if (ImGui::BeginCombo(label.c_str(), preview.c_str())) {
         for (int i = 0; i < static_cast<int>(names.size()); ++i) {

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 namespace clothsim {
 namespace {
@@ -75,22 +76,53 @@ Topology grid_topology(int rows, int cols, const DVec3Array& position, bool mate
 
 std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins) {
     const int rows = cloth.rows, cols = cloth.cols;
+    // A clip holds the particles within its radius at rest. Rest positions are build_simulation's:
+    // origin + c du u + r dv v, u and v normalised, so particles dc columns and dr rows apart lie
+    // |dc du u + dr dv v| apart in the cloth's plane, whose square is (dc du)^2 + (dr dv)^2 + 2 dc du dr dv (u . v)
+    // (exact for axes that are not perpendicular too).
+    const double du = cols > 1 ? double(cloth.size.x) / (cols - 1) : 0.0;
+    const double dv = rows > 1 ? double(cloth.size.y) / (rows - 1) : 0.0;
+    const glm::dvec3 u = glm::normalize(glm::dvec3(cloth.u_axis)), v = glm::normalize(glm::dvec3(cloth.v_axis));
+    const double cos_uv = glm::dot(u, v);
+    // A particle dc columns away is at least |dc| du sin(angle) from the clip's centre (its distance to the
+    // line through the centre along v), so only a box of rows and columns needs looking at.
+    const double sin_uv = std::sqrt(std::max(0.0, 1.0 - cos_uv * cos_uv));
     std::vector<std::size_t> out;
-    auto pin = [&](int r, int c) {
+    auto pin = [&](int r, int c, double radius) {
         if (r < 0 || r >= rows || c < 0 || c >= cols) {
             throw SceneError("pins: particle [" + std::to_string(r) + ", " + std::to_string(c) + "] is outside the " +
                              std::to_string(rows) + " x " + std::to_string(cols) + " grid");
         }
         out.push_back(static_cast<std::size_t>(r) * cols + c);
+        if (!(radius > 0.0)) return;  // a point pin
+        // A particle on the clip's rim counts: the radius is widened by 1e-6 of itself, far below any grid
+        // spacing, so a radius written as exactly k spacings (0.02 m at 0.01 m spacing) is not lost to rounding.
+        const double reach = radius * (1.0 + 1e-6);
+        auto span = [&](double spacing, int count) {
+            return spacing > 0.0 ? static_cast<int>(std::min<double>(count, std::floor(reach / (spacing * sin_uv))))
+                                 : 0;
+        };
+        const int dc_max = span(du, cols), dr_max = span(dv, rows);
+        for (int rr = std::max(0, r - dr_max); rr <= std::min(rows - 1, r + dr_max); ++rr) {
+            for (int cc = std::max(0, c - dc_max); cc <= std::min(cols - 1, c + dc_max); ++cc) {
+                const double a = (cc - c) * du, b = (rr - r) * dv;
+                if (a * a + b * b + 2.0 * a * b * cos_uv <= reach * reach) {
+                    out.push_back(static_cast<std::size_t>(rr) * cols + cc);
+                }
+            }
+        }
     };
+    const double clip = pins.preset_radius;
     switch (pins.preset) {
         case PinPreset::None: break;
-        case PinPreset::TopCorners: pin(0, 0); pin(0, cols - 1); break;
-        case PinPreset::TopRow: for (int c = 0; c < cols; ++c) pin(0, c); break;
-        case PinPreset::FourCorners: pin(0, 0); pin(0, cols - 1); pin(rows - 1, 0); pin(rows - 1, cols - 1); break;
-        case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0); break;
+        case PinPreset::TopCorners: pin(0, 0, clip); pin(0, cols - 1, clip); break;
+        case PinPreset::TopRow: for (int c = 0; c < cols; ++c) pin(0, c, clip); break;
+        case PinPreset::FourCorners:
+            pin(0, 0, clip); pin(0, cols - 1, clip); pin(rows - 1, 0, clip); pin(rows - 1, cols - 1, clip);
+            break;
+        case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0, clip); break;
     }
-    for (const auto& [r, c] : pins.particles) pin(r, c);
+    for (const PinClip& p : pins.particles) pin(p.row, p.col, p.radius);
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;

@@ -53,7 +53,7 @@ const std::array kFields = {
     FieldInfo{"forces.gust_frequency", "Hz", 0, 100, "main gust frequency", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_frequency; }},
     FieldInfo{"forces.max_speed", "m/s", 0, 1e4, "0 = off; else every particle's speed is clamped to this", [](Scene& s) -> FieldRef { return &s.settings.forces.max_speed; }},
 
-    FieldInfo{"pins", "", 0, 0, "a preset name, a list of [row, col], or { preset = NAME, particles = [[row, col], ...] }", [](Scene& s) -> FieldRef { return &s.pins; }},
+    FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest; the table's radius makes each preset pin a clip", [](Scene& s) -> FieldRef { return &s.pins; }},
 
     FieldInfo{"colliders.sphere.enabled", "", 0, 0, "collide with the sphere", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.enabled; }},
     FieldInfo{"colliders.sphere.center", "m", -kBig, kBig, "sphere centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.center; }},
@@ -128,6 +128,8 @@ std::span<const std::string_view> solver_method_names() { return kSolverMethodNa
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
 std::span<const std::string_view> contact_model_names() { return kContactModelNames; }
 
+std::string describe_pin_radius() { return cat("a number in [0.0, ", number(kMaxPinRadius), "] m"); }
+
 std::string describe_allowed(const FieldInfo& field) {
     Scene scratch;
     const std::string unit = field.unit.empty() ? "" : cat(" ", field.unit);
@@ -144,7 +146,12 @@ std::string describe_allowed(const FieldInfo& field) {
             [&](glm::vec2*) { return cat("one number or [x, y], each in ", range(field), unit); },
             [&](glm::vec3*) { return cat("[x, y, z], each in ", range(field), unit); },
             [&](std::string*) { return std::string("a string"); },
-            [&](PinSpec*) { return "one of " + join(kPinPresetNames) + ", a list of [row, col], or a table with preset and particles"; },
+            [&](PinSpec*) {
+                return cat("one of ", join(kPinPresetNames),
+                           ", a list of [row, col] or { particle = [row, col], radius = R }, or a table with preset, "
+                           "radius and particles; R: ",
+                           describe_pin_radius(), " (0 = a point pin)");
+            },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return "one of " + join(names_of(v)); },
         },
         field.ref(scratch));
@@ -185,12 +192,18 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
             [&](const std::string* v) { return quoted(*v); },
             [&](const PinSpec* v) {
                 std::string preset = quoted(kPinPresetNames[static_cast<int>(v->preset)]);
-                if (v->particles.empty()) return preset;
+                if (v->particles.empty() && v->preset_radius == 0.0f) return preset;
+                std::string out = cat("{ preset = ", preset);
+                if (v->preset_radius != 0.0f) out += cat(", radius = ", number(v->preset_radius));
+                if (v->particles.empty()) return cat(out, " }");
                 std::string list;
-                for (const auto& [r, c] : v->particles) {
-                    list += cat(list.empty() ? "" : ", ", "[", std::to_string(r), ", ", std::to_string(c), "]");
+                for (const PinClip& p : v->particles) {
+                    const std::string cell = cat("[", std::to_string(p.row), ", ", std::to_string(p.col), "]");
+                    const std::string pin =
+                        p.radius == 0.0f ? cell : cat("{ particle = ", cell, ", radius = ", number(p.radius), " }");
+                    list += cat(list.empty() ? "" : ", ", pin);
                 }
-                return cat("{ preset = ", preset, ", particles = [", list, "] }");
+                return cat(out, ", particles = [", list, "] }");
             },
             [&]<class Enum>(const Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
         },
@@ -236,7 +249,16 @@ void validate(const Scene& scene) {
                          " leaves penalty contact no shell to push in; allowed with colliders.contact = \"penalty\": "
                          "a thickness in (0.0, 1.0] m");
     }
-    for (const auto& [r, col] : scene.pins.particles) {
+    auto check_radius = [&](float radius, const std::string& what) {
+        if (!(radius >= 0.0f && radius <= static_cast<float>(kMaxPinRadius))) {
+            throw SceneError(
+                cat("pins: ", what, " = ", number(radius), " is out of range; allowed: ", describe_pin_radius()));
+        }
+    };
+    check_radius(scene.pins.preset_radius, "radius");
+    for (const PinClip& pin : scene.pins.particles) {
+        const int r = pin.row, col = pin.col;
+        check_radius(pin.radius, cat("the radius of the clip at [", std::to_string(r), ", ", std::to_string(col), "]"));
         if (r < 0 || r >= c.rows || col < 0 || col >= c.cols) {
             throw SceneError("pins: particle [" + std::to_string(r) + ", " + std::to_string(col) +
                              "] is outside the " + std::to_string(c.rows) + " x " + std::to_string(c.cols) +

@@ -108,29 +108,107 @@ std::optional<Enum> enum_of(const toml::node& node, std::span<const std::string_
     return std::nullopt;
 }
 
-std::optional<std::vector<std::pair<int, int>>> pin_list_of(const toml::node& node) {
+// Why a value was refused, when more can be said than "not allowed": the part at fault, and its node (for
+// the line of an entry deep inside a multi-line list).
+struct Rejection {
+    std::string why;
+    const toml::node* at = nullptr;
+};
+
+constexpr const char* kClipForm = "{ particle = [row, col], radius = R }";
+
+// A clip's radius: a number in [0, kMaxPinRadius] m.
+std::optional<float> pin_radius_of(const toml::node& node, const std::string& name, Rejection& rejection) {
+    const auto v = number_of(node);
+    if (!v || !std::isfinite(*v) || *v < 0.0 || *v > kMaxPinRadius) {
+        rejection = {name + " = " + show(node) + " is " + (v ? "out of range" : "not a number") + "; allowed: " +
+                         describe_pin_radius(),
+                     &node};
+        return std::nullopt;
+    }
+    return static_cast<float>(*v);
+}
+
+// [row, col]: two integers that fit in int (beyond int, a cast would wrap, 2^32 -> 0, and pin a particle the
+// file never named; validate() checks that they lie in the grid).
+std::optional<std::pair<int, int>> pin_cell_of(const toml::node& node, const std::string& name, Rejection& rejection) {
+    const toml::array* pair = node.as_array();
+    if (!pair || pair->size() != 2 || !(*pair)[0].is_integer() || !(*pair)[1].is_integer()) {
+        rejection = {name + " = " + show(node) + " is not a particle; allowed: [row, col], two integers", &node};
+        return std::nullopt;
+    }
+    const std::int64_t r = (*pair)[0].as_integer()->get(), c = (*pair)[1].as_integer()->get();
+    constexpr std::int64_t lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+    if (r < lo || r > hi || c < lo || c > hi) {
+        rejection = {name + " = " + show(node) + " lies outside every grid; allowed: [row, col] inside the grid",
+                     &node};
+        return std::nullopt;
+    }
+    return std::pair{static_cast<int>(r), static_cast<int>(c)};
+}
+
+// One pin: [row, col], or a clip { particle = [row, col], radius = R }.
+std::optional<PinClip> pin_of(const toml::node& node, const std::string& name, Rejection& rejection) {
+    const toml::table* table = node.as_table();
+    if (!table) {
+        if (!node.is_array()) {
+            rejection = {name + " = " + show(node) + " is not a pin; allowed: [row, col] or " + kClipForm, &node};
+            return std::nullopt;
+        }
+        const auto cell = pin_cell_of(node, name, rejection);
+        if (!cell) return std::nullopt;
+        return PinClip{cell->first, cell->second, 0.0f};
+    }
+    std::optional<std::pair<int, int>> cell;
+    float radius = 0.0f;
+    for (auto&& [key, value] : *table) {
+        if (key.str() == "particle") {
+            cell = pin_cell_of(value, name + ".particle", rejection);
+            if (!cell) return std::nullopt;
+        } else if (key.str() == "radius") {
+            const auto r = pin_radius_of(value, name + ".radius", rejection);
+            if (!r) return std::nullopt;
+            radius = *r;
+        } else {
+            rejection = {name + " has an unknown key '" + std::string(key.str()) + "'; allowed keys: particle, radius",
+                         &value};
+            return std::nullopt;
+        }
+    }
+    if (!cell) {
+        rejection = {name + " = " + show(node) + " names no particle; allowed: " + kClipForm, &node};
+        return std::nullopt;
+    }
+    return PinClip{cell->first, cell->second, radius};
+}
+
+// A list of pins; `name` is how messages call the list ("pins", "pins.particles").
+std::optional<std::vector<PinClip>> pin_list_of(const toml::node& node, const std::string& name,
+                                                Rejection& rejection) {
     const toml::array* array = node.as_array();
-    if (!array) return std::nullopt;
-    std::vector<std::pair<int, int>> out;
-    for (const toml::node& item : *array) {
-        const toml::array* pair = item.as_array();
-        if (!pair || pair->size() != 2 || !(*pair)[0].is_integer() || !(*pair)[1].is_integer()) return std::nullopt;
-        const std::int64_t r = (*pair)[0].as_integer()->get(), c = (*pair)[1].as_integer()->get();
-        // Beyond int, a cast would wrap (2^32 -> 0) and pin a particle the file never named.
-        constexpr std::int64_t lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
-        if (r < lo || r > hi || c < lo || c > hi) return std::nullopt;
-        out.emplace_back(static_cast<int>(r), static_cast<int>(c));
+    if (!array) {
+        rejection = {name + " = " + show(node) + " is not a list; allowed: a list of [row, col] or " + kClipForm,
+                     &node};
+        return std::nullopt;
+    }
+    std::vector<PinClip> out;
+    for (std::size_t i = 0; i < array->size(); ++i) {
+        const auto pin = pin_of(*array->get(i), name + "[" + std::to_string(i) + "]", rejection);
+        if (!pin) return std::nullopt;
+        out.push_back(*pin);
     }
     return out;
 }
 
-std::optional<PinSpec> pins_of(const toml::node& node) {
+std::optional<PinSpec> pins_of(const toml::node& node, Rejection& rejection) {
     PinSpec spec;
     if (auto preset = enum_of<PinPreset>(node, pin_preset_names())) {
         spec.preset = *preset;
         return spec;
     }
-    if (auto list = pin_list_of(node)) {
+    if (node.is_array()) {
+        auto list = pin_list_of(node, "pins", rejection);
+        if (!list) return std::nullopt;
         spec.preset = PinPreset::None;
         spec.particles = *list;
         return spec;
@@ -140,13 +218,25 @@ std::optional<PinSpec> pins_of(const toml::node& node) {
         for (auto&& [key, value] : *table) {
             if (key.str() == "preset") {
                 auto preset = enum_of<PinPreset>(value, pin_preset_names());
-                if (!preset) return std::nullopt;
+                if (!preset) {
+                    std::string names;
+                    for (std::string_view n : pin_preset_names()) names += (names.empty() ? "" : ", ") + std::string(n);
+                    rejection = {"pins.preset = " + show(value) + " is not a preset; allowed: " + names, &value};
+                    return std::nullopt;
+                }
                 spec.preset = *preset;
+            } else if (key.str() == "radius") {
+                const auto radius = pin_radius_of(value, "pins.radius", rejection);
+                if (!radius) return std::nullopt;
+                spec.preset_radius = *radius;
             } else if (key.str() == "particles") {
-                auto list = pin_list_of(value);
+                auto list = pin_list_of(value, "pins.particles", rejection);
                 if (!list) return std::nullopt;
                 spec.particles = *list;
             } else {
+                rejection = {"pins has an unknown key '" + std::string(key.str()) +
+                                 "'; allowed keys: preset, radius, particles",
+                             &value};
                 return std::nullopt;
             }
         }
@@ -156,8 +246,8 @@ std::optional<PinSpec> pins_of(const toml::node& node) {
 }
 
 // Sets one field from a TOML node. Returns false (and leaves the scene alone) when the node's type or
-// value is not allowed; validate() checks cross-field rules afterwards.
-bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
+// value is not allowed, saying why in `rejection` where it can; validate() checks cross-field rules afterwards.
+bool assign(Scene& scene, const FieldInfo& field, const toml::node& node, Rejection& rejection) {
     auto in_range = [&](double v) { return std::isfinite(v) && v >= field.min && v <= field.max; };
     return std::visit(
         Overloaded{
@@ -203,7 +293,7 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node) {
                 return true;
             },
             [&](PinSpec* target) {
-                const auto v = pins_of(node);
+                const auto v = pins_of(node, rejection);
                 if (!v) return false;
                 *target = *v;
                 return true;
@@ -275,9 +365,11 @@ void load_table(Scene& scene, const toml::table& table, const std::string& prefi
     for (auto&& [key, node] : table) {
         const std::string name = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
         if (const FieldInfo* field = find_field(name)) {
-            if (!assign(scene, *field, node)) {
-                throw SceneError(where(source, node) + ": " + name + " = " + show(node) + " is not allowed; allowed: " +
-                                 describe_allowed(*field));
+            if (Rejection rejection; !assign(scene, *field, node, rejection)) {
+                throw SceneError(where(source, rejection.at ? *rejection.at : node) + ": " + name + " = " + show(node) +
+                                 " is not allowed" +
+                                 (rejection.why.empty() ? "; allowed: " + describe_allowed(*field)
+                                                        : ": " + rejection.why));
             }
             note_field_set(scene, name);
         } else if (is_section(name)) {
@@ -398,9 +490,9 @@ void apply_override(Scene& scene, std::string_view assignment) {
     const toml::node& node = parsed && parsed->contains("value") ? *parsed->get("value")
                                                                     : static_cast<const toml::node&>(bare);
     Scene candidate = scene;
-    if (!assign(candidate, *field, node)) {
-        throw SceneError(source + ": " + key + " = " + show(node) + " is not allowed; allowed: " +
-                         describe_allowed(*field));
+    if (Rejection rejection; !assign(candidate, *field, node, rejection)) {
+        throw SceneError(source + ": " + key + " = " + show(node) + " is not allowed" +
+                         (rejection.why.empty() ? "; allowed: " + describe_allowed(*field) : ": " + rejection.why));
     }
     note_field_set(candidate, key);
     try {

@@ -108,6 +108,25 @@ TEST_CASE("cli: --headless --json prints only a JSON report on stdout") {
     CHECK(std::isfinite(j.at("kinetic_energy").get<double>()));
     CHECK(std::isfinite(j.at("potential_energy").get<double>()));
     CHECK(j.at("kinetic_energy").get<double>() >= 0.0);
+    // A draped cloth is stretched a little, not torn apart (6.5% measured).
+    REQUIRE(j.at("max_strain").is_number());
+    CHECK(j.at("max_strain").get<double>() > 0.0);
+    CHECK(j.at("max_strain").get<double>() < 0.2);
+}
+
+TEST_CASE("cli: --json max_strain: clips at hanging's corners stretch the cloth less than point pins") {
+    auto max_strain = [](const std::string& pins) {
+        const RunResult r = run_clothsim({"--headless", "--scene", "hanging", "--set", "springs.damping=2", "--set",
+                                          "pins=" + pins, "--duration", "3", "--json"});
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        return nlohmann::json::parse(r.out).at("max_strain").get<double>();
+    };
+    const double point = max_strain("top-corners");
+    const double clip = max_strain("{ preset = \"top-corners\", radius = 0.15 }");
+    INFO("point pins " << point << ", clips " << clip);  // measured 0.220 and 0.131
+    CHECK(point > 0.15);
+    CHECK(clip < 0.7 * point);
 }
 
 TEST_CASE("cli: --set changes the scene that is run") {
@@ -337,6 +356,7 @@ TEST_CASE("cli: a simulation that blows up exits 3 and reports finite false") {
         CHECK(j.at("steps").get<long long>() >= 1);
         CHECK(j.at("steps").get<long long>() < 50);
         CHECK(j.at("kinetic_energy").is_null());
+        CHECK(j.at("max_strain").is_null());
         CHECK_THAT(r.err, Contains("non-finite"));
     }
 }

@@ -94,6 +94,29 @@ TEST_CASE("user session: launched paused with every debug view, the first frames
     }
 }
 
+TEST_CASE("user session: every particle a clip holds shows a pin marker, the free one beside it none") {
+    // flag (24 x 36, 1.5 m x 1 m, facing the camera) held by its left edge and a clip of 0.15 m in the middle:
+    // 37 particles lie within 0.15 m of [12, 18] at spacings of 0.043 m by 0.043 m.
+    const std::string clips = "pins={ preset = \"left-edge\", particles = [{ particle = [12, 18], radius = 0.15 }] }";
+    clothsim::Scene scene = clothsim::load_scene("flag");
+    clothsim::apply_override(scene, clips);
+    const std::vector<std::size_t> pins = pinned_particles(scene);
+    REQUIRE(pins.size() == 24 + 37);
+    const TempDir dir("session_clip_markers");
+    const RunResult r =
+        run_user_session(dir, {"--scene", "flag", "--set", clips, "--paused"}, "shot start.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const Image image = load_png(dir / "start.png");
+    REQUIRE(image.width == kWidth);
+    for (std::size_t pin : pins) {
+        INFO("pin " << pin);
+        CHECK(red_near(image, particle_on_screen(scene, pin), 3));
+    }
+    // [12, 22] lies 0.17 m from the clip's centre: free, and drawn as cloth.
+    CHECK_FALSE(red_near(image, particle_on_screen(scene, 12 * 36 + 22), 2));
+}
+
 TEST_CASE("user session: Reset while paused shows the start state, debug views included") {
     const TempDir dir("session_reset_paused");
     // Start, play 1.5 s, pause, look, Reset, look.

@@ -150,3 +150,64 @@ TEST_CASE("cloth_builder vertex normals of a flat cloth are u x v; a folded one 
     compute_vertex_normals(chain, p, normals);
     CHECK(normals[3] == glm::vec3(0.0f, 1.0f, 0.0f));
 }
+
+TEST_CASE("cloth_builder: a clip pins exactly the particles within its radius at rest", "[cloth_builder][pins]") {
+    using V = std::vector<std::size_t>;
+    ClothSettings cloth;
+    cloth.rows = 5;
+    cloth.cols = 5;
+    cloth.size = {0.4f, 0.4f};  // spacing 0.1 m both ways; particle [r, c] is index 5 r + c
+    auto clip = [&](int r, int c, float radius) {
+        return pinned_particles(cloth, {PinPreset::None, {{r, c, radius}}});
+    };
+    // Around [2, 2] (index 12): the 4 neighbours lie 0.1 m away, the 4 diagonals 0.141 m, the next ring 0.2 m.
+    CHECK(clip(2, 2, 0.0f) == V{12});
+    CHECK(clip(2, 2, 0.09f) == V{12});
+    CHECK(clip(2, 2, 0.1f) == V{7, 11, 12, 13, 17});  // a particle on the rim is held
+    CHECK(clip(2, 2, 0.15f) == V{6, 7, 8, 11, 12, 13, 16, 17, 18});
+    CHECK(clip(2, 2, 0.2f) == V{2, 6, 7, 8, 10, 11, 12, 13, 14, 16, 17, 18, 22});
+    // At a corner the clip is cut by the cloth's edges; a radius larger than the cloth pins all of it.
+    CHECK(clip(0, 0, 0.15f) == V{0, 1, 5, 6});
+    CHECK(clip(4, 4, 1.0f).size() == 25);
+
+    // Unequal spacing: 0.1 m along u, 0.2 m along v. Within 0.25 m of [0, 0]: (0.1 c)^2 + (0.2 r)^2 <= 0.0625
+    // holds for row 0, cols 0-2 and row 1, cols 0-1.
+    cloth.size = {0.4f, 0.8f};
+    CHECK(clip(0, 0, 0.25f) == V{0, 1, 2, 5, 6});
+
+    // The preset's radius makes each of its pins a clip; explicit pins keep their own radius.
+    cloth.size = {0.4f, 0.4f};
+    CHECK(pinned_particles(cloth, {PinPreset::TopCorners, {}, 0.1f}) == V{0, 1, 3, 4, 5, 9});
+    CHECK(pinned_particles(cloth, {PinPreset::TopCorners, {{4, 2}}, 0.1f}) == V{0, 1, 3, 4, 5, 9, 22});
+    CHECK(pinned_particles(cloth, {PinPreset::TopCorners, {{4, 2, 0.1f}}}) == V{0, 4, 17, 21, 22, 23});
+
+    // A clip centred outside the grid is refused like a point pin.
+    CHECK_THROWS_WITH(clip(5, 0, 0.5f), Catch::Contains("[5, 0]") && Catch::Contains("5 x 5 grid"));
+}
+
+TEST_CASE("cloth_builder: a clip holds the particles within its radius of the built cloth, skewed axes too",
+          "[cloth_builder][pins]") {
+    // Axes 60 degrees apart: the distance in the cloth's plane is not sqrt((dc du)^2 + (dr dv)^2). Compare
+    // every particle's pin with its distance to the clip's centre in the built cloth.
+    Scene s;
+    s.cloth.rows = 9;
+    s.cloth.cols = 11;
+    s.cloth.size = {1.0f, 0.8f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.5f, -std::sqrt(3.0f) / 2.0f, 0.0f};
+    s.pins = {PinPreset::None, {{4, 5, 0.23f}}};
+    const MassSpring sim = build_simulation(s);
+    const glm::vec3 centre = sim.position(s.cloth.cols * 4 + 5);
+    int pinned = 0;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const float distance = glm::length(sim.position(i) - centre);
+        INFO("particle " << i << " at " << distance << " m");
+        REQUIRE(std::abs(distance - 0.23f) > 1e-4f);  // none on the rim: the comparison is not about rounding
+        CHECK(static_cast<bool>(sim.state().pinned[i]) == (distance < 0.23f));
+        CHECK((sim.state().inverse_mass[i] == 0.0f) == (distance < 0.23f));
+        pinned += sim.state().pinned[i];
+    }
+    // Spacing 0.1 m both ways: particles a columns and b rows away lie 0.1 sqrt(a^2 + b^2 + a b) m apart,
+    // within 0.23 m for 19 (a, b); perpendicular axes would hold 21.
+    CHECK(pinned == 19);
+}

@@ -358,7 +358,7 @@ TEST_CASE("scene file: a valid file from disk loads") {
     CHECK(s.cloth.rows == 3);
     CHECK(s.cloth.cols == 2);
     CHECK(s.pins.preset == clothsim::PinPreset::TopRow);
-    CHECK(s.pins.particles == std::vector<std::pair<int, int>>{{2, 1}});
+    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{2, 1}});
     CHECK(s.cloth.size == glm::vec2(0.5f, 0.5f));
     CHECK(s.settings.colliders.sphere.enabled);
     CHECK(s.settings.colliders.sphere.radius == 0.25f);
@@ -427,10 +427,10 @@ TEST_CASE("scene override: ints, floats, vectors, booleans, strings and bare wor
     CHECK(s.pins.preset == clothsim::PinPreset::FourCorners);
     clothsim::apply_override(s, "pins=[[0,0],[7,5]]");
     CHECK(s.pins.preset == clothsim::PinPreset::None);
-    CHECK(s.pins.particles == std::vector<std::pair<int, int>>{{0, 0}, {7, 5}});
+    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{0, 0}, {7, 5}});
     clothsim::apply_override(s, "pins={ preset = \"left-edge\", particles = [[3, 3]] }");
     CHECK(s.pins.preset == clothsim::PinPreset::LeftEdge);
-    CHECK(s.pins.particles == std::vector<std::pair<int, int>>{{3, 3}});
+    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{3, 3}});
 
     clothsim::apply_override(s, "forces.wind_model=uniform");
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Uniform);
@@ -664,6 +664,121 @@ TEST_CASE("scene pins: pinned_particles of every preset on a 4 x 5 grid") {
     cloth.cols = 1;
     CHECK(pins(clothsim::PinPreset::TopCorners) == V{0});
     CHECK(pins(clothsim::PinPreset::FourCorners) == V{0, 3});
+}
+
+TEST_CASE("scene pins: clips are read from a pins list, a pins table and --set") {
+    using Clips = std::vector<clothsim::PinClip>;
+    const clothsim::Scene preset =
+        clothsim::parse_scene("pins = { preset = \"top-corners\", radius = 0.02 }\n", "t.toml");
+    CHECK(preset.pins.preset == clothsim::PinPreset::TopCorners);
+    CHECK(preset.pins.preset_radius == 0.02f);
+    CHECK(preset.pins.particles.empty());
+
+    const clothsim::Scene list = clothsim::parse_scene(
+        "pins = [[0, 0], { particle = [3, 1], radius = 0.05 }, { particle = [2, 2] }]\n", "t.toml");
+    CHECK(list.pins.preset == clothsim::PinPreset::None);
+    CHECK(list.pins.preset_radius == 0.0f);
+    CHECK(list.pins.particles == Clips{{0, 0, 0.0f}, {3, 1, 0.05f}, {2, 2, 0.0f}});
+
+    const clothsim::Scene table = clothsim::parse_scene(
+        "pins = { preset = \"left-edge\", radius = 0, particles = [{ radius = 1, particle = [1, 2] }] }\n", "t.toml");
+    CHECK(table.pins.preset == clothsim::PinPreset::LeftEdge);
+    CHECK(table.pins.preset_radius == 0.0f);
+    CHECK(table.pins.particles == Clips{{1, 2, 1.0f}});
+
+    clothsim::Scene s;
+    clothsim::apply_override(
+        s, "pins={ preset = \"top-row\", radius = 0.01, particles = [{ particle = [7, 5], radius = 0.3 }] }");
+    CHECK(s.pins.preset == clothsim::PinPreset::TopRow);
+    CHECK(s.pins.preset_radius == 0.01f);
+    CHECK(s.pins.particles == Clips{{7, 5, 0.3f}});
+    // A preset name alone drops the clip radius with the rest of the old pins.
+    clothsim::apply_override(s, "pins=top-corners");
+    CHECK(s.pins == clothsim::PinSpec{});
+}
+
+TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [row, col]") {
+    clothsim::Scene s;
+    s.cloth.rows = 6;
+    s.cloth.cols = 5;
+    s.pins = {clothsim::PinPreset::TopCorners, {{5, 4, 0.0f}, {2, 3, 0.05f}}, 0.02f};
+    const std::string text = clothsim::to_toml(s);
+    CHECK_THAT(text, Contains("pins = { preset = \"top-corners\", radius = 0.02, particles = [[5, 4], "
+                              "{ particle = [2, 3], radius = 0.05 }] }\n"));
+    const clothsim::Scene back = clothsim::parse_scene(text, "clips.toml");
+    CHECK(back.pins == s.pins);
+    CHECK(clothsim::to_toml(back) == text);
+
+    // The preset's radius alone; explicit clips alone; the largest radius; a radius that is no short decimal.
+    for (const clothsim::PinSpec& pins :
+         {clothsim::PinSpec{clothsim::PinPreset::FourCorners, {}, 0.125f},
+          clothsim::PinSpec{clothsim::PinPreset::None, {{1, 1, 1.0f}, {0, 4, 1e-7f}}},
+          clothsim::PinSpec{clothsim::PinPreset::LeftEdge, {{3, 0, 0.1f / 3.0f}}, 0.7f}}) {
+        s.pins = pins;
+        const std::string written = clothsim::to_toml(s);
+        INFO(written);
+        const clothsim::Scene again = clothsim::parse_scene(written, "again.toml");
+        CHECK(again.pins == pins);
+        CHECK(clothsim::to_toml(again) == written);
+    }
+    // Point pins keep the short forms they had before clips existed.
+    s.pins = {clothsim::PinPreset::TopRow, {}};
+    CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "\"top-row\"");
+    s.pins = {clothsim::PinPreset::None, {{1, 1}}};
+    CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "{ preset = \"none\", particles = [[1, 1]] }");
+}
+
+TEST_CASE("scene pins: a bad clip is rejected with its line, the part at fault and what is allowed") {
+    // A negative radius, in the table and in a list entry on its own line.
+    const std::string negative = parse_error("name = \"x\"\npins = { preset = \"top-corners\", radius = -0.01 }\n");
+    CHECK_THAT(negative, Contains("test.toml:2:"));
+    CHECK_THAT(negative, Contains("pins.radius = -0.01 is out of range; allowed: a number in [0.0, 1.0] m"));
+    const std::string entry = parse_error("pins = [\n  [0, 0],\n  { particle = [0, 3], radius = -1 },\n]\n");
+    CHECK_THAT(entry, Contains("test.toml:3:"));
+    CHECK_THAT(entry, Contains("pins[1].radius = -1 is out of range"));
+    CHECK_THAT(parse_error("pins = { preset = \"none\", particles = [{ particle = [0, 0], radius = 2 }] }\n"),
+               Contains("pins.particles[0].radius = 2 is out of range; allowed: a number in [0.0, 1.0] m"));
+    CHECK_THAT(parse_error("pins = { preset = \"top-row\", radius = nan }\n"),
+               Contains("pins.radius = nan is out of range"));
+
+    // Unknown keys, in a clip and in the pins table, with the keys that are known.
+    CHECK_THAT(parse_error("pins = [{ particle = [0, 0], radios = 0.1 }]\n"),
+               Contains("pins[0] has an unknown key 'radios'; allowed keys: particle, radius"));
+    CHECK_THAT(parse_error("pins = { preset = \"none\", clip = 0.1 }\n"),
+               Contains("pins has an unknown key 'clip'; allowed keys: preset, radius, particles"));
+
+    // Wrong types.
+    CHECK_THAT(parse_error("pins = [{ particle = [0, 0], radius = \"wide\" }]\n"),
+               Contains("pins[0].radius = 'wide' is not a number; allowed: a number in [0.0, 1.0] m"));
+    CHECK_THAT(parse_error("pins = [{ particle = 3, radius = 0.1 }]\n"),
+               Contains("pins[0].particle = 3 is not a particle; allowed: [row, col], two integers"));
+    CHECK_THAT(parse_error("pins = [{ radius = 0.1 }]\n"),
+               Contains("pins[0] = { radius = 0.1 } names no particle; allowed: "
+                        "{ particle = [row, col], radius = R }"));
+    CHECK_THAT(parse_error("pins = [[0, 0], true]\n"),
+               Contains("pins[1] = true is not a pin; allowed: [row, col] or { particle = [row, col], radius = R }"));
+    CHECK_THAT(parse_error("pins = { particles = 5 }\n"), Contains("pins.particles = 5 is not a list"));
+
+    // A clip centred outside the grid, as a point pin outside it.
+    const std::string outside =
+        parse_error("pins = [{ particle = [4, 0], radius = 0.5 }]\n[cloth]\nrows = 4\ncols = 3\n");
+    CHECK_THAT(outside, Contains("test.toml:1:"));
+    CHECK_THAT(outside, Contains("[4, 0]") && Contains("row in [0, 3], col in [0, 2]"));
+
+    // --set names the flag; the scene is left as it was.
+    clothsim::Scene scene;
+    const clothsim::Scene before = scene;
+    const std::string set = override_error(scene, "pins={ preset = \"top-row\", radius = -1 }");
+    CHECK_THAT(set, Contains("--set pins=") && Contains("pins.radius = -1 is out of range"));
+    CHECK(scene.pins == before.pins);
+
+    // A scene made in code is checked too (validate, build_simulation).
+    scene.pins.preset_radius = -0.5f;
+    CHECK_THROWS_WITH(clothsim::validate(scene),
+                      Contains("pins: radius = -0.5 is out of range; allowed: a number in [0.0, 1.0] m"));
+    scene.pins = {clothsim::PinPreset::None, {{1, 1, 1.5f}}};
+    CHECK_THROWS_WITH(clothsim::build_simulation(scene),
+                      Contains("pins: the radius of the clip at [1, 1] = 1.5 is out of range"));
 }
 
 TEST_CASE("scene build: build_simulation pins the particles of the scene") {

@@ -68,7 +68,7 @@ struct SpringConstants {
     glm::dvec2 bending;     // N/m: k of an inner bend along u (B_u h_v / h_u^3), along v
     double poisson_uv = 0.0;  // contraction along v per stretch along u, uniaxial
     double poisson_vu = 0.0;
-    double total_mass = 0.0;  // kg: density x area
+    double total_mass = 0.0;  // kg: density x the area of the shape's cells
 };
 // Throws SceneError when the grid has a single row or column (no cells), or when the shear is so large
 // against the stretch at this cell aspect that a structural spring would need a negative k.

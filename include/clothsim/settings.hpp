@@ -26,6 +26,13 @@ enum class Integrator {
     Xpbd,             // extended position-based dynamics, one iteration per substep, compliance 1/k
 };
 
+// The outline of the cloth on its grid.
+enum class ClothShape {
+    Rectangle,  // every particle of the rows x cols grid
+    Disc,       // the particles inside the grid's inscribed circle (ellipse for unequal sides): a Cusick
+                // specimen; the others are absent (state.hpp), with no springs, mass or triangles
+};
+
 // Which implementation advances the cloth. Both integrate the same model; see src/core/fast_solver.hpp.
 enum class SolverMethod {
     Fast,      // row sweeps over the grid: vectorised, multi-threaded, each spring once, stages fused
@@ -69,6 +76,7 @@ struct ClothSettings {
     glm::vec3 u_axis{1.0f, 0.0f, 0.0f};      // direction of increasing column (normalised when built)
     glm::vec3 v_axis{0.0f, -1.0f, 0.0f};     // direction of increasing row (normalised when built)
     glm::vec3 velocity{0.0f, 0.0f, 0.0f};    // m/s: initial velocity of every free particle
+    ClothShape shape = ClothShape::Rectangle;
 };
 
 // The stiffness every spring and bend uses, by kind and axis (spring.hpp). A per-spring scene sets them

@@ -45,6 +45,12 @@ struct BasicVec3Array {
 using Vec3Array = BasicVec3Array<float>;
 using DVec3Array = BasicVec3Array<double>;
 
+// Values of State::pinned besides 0 (free). An absent particle is a grid slot outside the cloth's shape (a
+// disc, settings.hpp): it has no mass, springs, bends or triangles, never moves, and is neither drawn nor
+// picked. Keeping the slot keeps the grid's layout for the fast solver.
+inline constexpr std::uint8_t kPinned = 1;
+inline constexpr std::uint8_t kAbsent = 2;
+
 struct Topology {
     int rows = 0;
     int cols = 0;
@@ -74,7 +80,7 @@ struct State {
     // Parameters, not accumulators: float is exact enough and halves what the integration loops read.
     std::vector<float> mass;          // kg (kept for pinned particles too, for energy and momentum)
     std::vector<float> inverse_mass;  // 1/kg, 0 for pinned particles
-    std::vector<std::uint8_t> pinned;
+    std::vector<std::uint8_t> pinned;  // 0 free, else kPinned or kAbsent: either never moves
     double time = 0.0;     // s
     double substep = 0.0;  // s: the substep `motion` belongs to
     // Which integrator's convention `motion` follows: Verlet keeps x - x_prev; every other integrator keeps

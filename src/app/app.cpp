@@ -25,6 +25,7 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -184,7 +185,7 @@ void pins_to_scene(AppState& app) {
     app.scene.pins.preset_radius = 0.0f;
     app.scene.pins.particles.clear();
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
-        if (app.sim.state().pinned[i]) {
+        if (app.sim.state().pinned[i] == kPinned) {
             app.scene.pins.particles.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols});
         }
     }
@@ -215,7 +216,11 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     }
     if (io.WantCaptureMouse) return;
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift) {
-        const std::vector<glm::vec3> positions = app.sim.positions();
+        std::vector<glm::vec3> positions = app.sim.positions();
+        // Slots outside the cloth's shape are not there to pick.
+        for (std::size_t i = 0; i < positions.size(); ++i) {
+            if (app.sim.state().pinned[i] == kAbsent) positions[i] = glm::vec3(NAN);
+        }
         const auto hit = pick_particle(cursor_ray(app, window, scale), positions, pick_spread(app.camera, 10.0f, height));
         if (hit && io.KeyCtrl) {
             const bool pinned = !app.sim.particle(*hit).pinned;

@@ -2,6 +2,7 @@
 // shear and bending springs (or bends, with [material]) whose rest lengths are the initial distances.
 #include "clothsim/scene.hpp"
 
+#include "clothsim/cloth_shape.hpp"
 #include "clothsim/material.hpp"
 
 #include <glm/geometric.hpp>
@@ -12,15 +13,17 @@
 namespace clothsim {
 namespace {
 
-// Springs by kind and direction, and in the material form bends instead of skip-one bending springs, with
-// the weights of the cell-by-cell assembly (material.hpp): an edge's structural springs and bends carry half.
-Topology grid_topology(int rows, int cols, const DVec3Array& position, bool material) {
+// Springs by kind and direction, and in the material form bends instead of skip-one bending springs. In the
+// material form each element's weight is its share of the cells it borders (material.hpp): a structural
+// spring or a bend on the cloth's edge borders one cell row instead of two and carries half. Only particles
+// and cells of the shape take part (cloth_shape.hpp).
+Topology grid_topology(const ShapeMask& shape, const DVec3Array& position, bool material) {
+    const int rows = shape.rows, cols = shape.cols;
     Topology t;
     t.rows = rows;
     t.cols = cols;
-    auto inside = [&](int r, int c) { return r >= 0 && r < rows && c >= 0 && c < cols; };
     auto add = [&](int r0, int c0, int r1, int c1, SpringKind kind, Axis axis, float weight) {
-        if (!inside(r0, c0) || !inside(r1, c1)) return;
+        if (!shape.has_particle(r0, c0) || !shape.has_particle(r1, c1) || weight == 0.0f) return;
         const auto a = static_cast<std::uint32_t>(t.index(r0, c0));
         const auto b = static_cast<std::uint32_t>(t.index(r1, c1));
         // The rest length in the spring kernels' arithmetic (float d, float length), so a spring at its start
@@ -29,38 +32,52 @@ Topology grid_topology(int rows, int cols, const DVec3Array& position, bool mate
         ++t.spring_count_by_kind[static_cast<int>(kind)];
     };
     auto add_bend = [&](int r0, int c0, int dr, int dc, Axis axis, float weight) {
-        if (!inside(r0, c0) || !inside(r0 + 2 * dr, c0 + 2 * dc)) return;
-        t.bends.push_back({static_cast<std::uint32_t>(t.index(r0, c0)), static_cast<std::uint32_t>(t.index(r0 + dr, c0 + dc)),
-                           static_cast<std::uint32_t>(t.index(r0 + 2 * dr, c0 + 2 * dc)), axis, weight});
+        const int r1 = r0 + dr, c1 = c0 + dc, r2 = r0 + 2 * dr, c2 = c0 + 2 * dc;
+        if (!shape.has_particle(r0, c0) || !shape.has_particle(r1, c1) || !shape.has_particle(r2, c2) ||
+            weight == 0.0f) {
+            return;
+        }
+        t.bends.push_back({static_cast<std::uint32_t>(t.index(r0, c0)), static_cast<std::uint32_t>(t.index(r1, c1)),
+                           static_cast<std::uint32_t>(t.index(r2, c2)), axis, weight});
         ++t.spring_count_by_kind[static_cast<int>(SpringKind::Bending)];
     };
-    // Half weight on the cloth's edge in the material form (a line there borders one cell, not two).
-    auto edge = [&](int i, int n) { return material && (i == 0 || i == n - 1) && n > 1 ? 0.5f : 1.0f; };
+    auto cell = [&](int r, int c) { return shape.has_cell(r, c) ? 1.0f : 0.0f; };
+    // The weights of the material form: half per bordering cell (row of cells, for a bend); 1 otherwise.
+    auto along_u = [&](int r, int c) { return material ? 0.5f * (cell(r - 1, c) + cell(r, c)) : 1.0f; };
+    auto along_v = [&](int r, int c) { return material ? 0.5f * (cell(r, c - 1) + cell(r, c)) : 1.0f; };
+    auto diagonal = [&](int r, int c) { return material ? cell(r, c) : 1.0f; };
+    auto bend_u = [&](int r, int c) {
+        return 0.5f * (cell(r - 1, c) * cell(r - 1, c + 1) + cell(r, c) * cell(r, c + 1));
+    };
+    auto bend_v = [&](int r, int c) {
+        return 0.5f * (cell(r, c - 1) * cell(r + 1, c - 1) + cell(r, c) * cell(r + 1, c));
+    };
     // Grouped by kind and direction: each group is a set of parallel springs (the layout a fast solver
     // sweeps without two springs of a group writing one particle in the same sweep position).
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r, c + 1, SpringKind::Structural, Axis::U, edge(r, rows));
+        for (int c = 0; c < cols; ++c) add(r, c, r, c + 1, SpringKind::Structural, Axis::U, along_u(r, c));
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c, SpringKind::Structural, Axis::V, edge(c, cols));
+        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c, SpringKind::Structural, Axis::V, along_v(r, c));
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c + 1, SpringKind::Shear, Axis::Diagonal, 1.0f);
+        for (int c = 0; c < cols; ++c) add(r, c, r + 1, c + 1, SpringKind::Shear, Axis::Diagonal, diagonal(r, c));
     for (int r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c) add(r, c + 1, r + 1, c, SpringKind::Shear, Axis::Diagonal, 1.0f);
+        for (int c = 0; c < cols; ++c) add(r, c + 1, r + 1, c, SpringKind::Shear, Axis::Diagonal, diagonal(r, c));
     if (material) {
         for (int r = 0; r < rows; ++r)
-            for (int c = 0; c < cols; ++c) add_bend(r, c, 0, 1, Axis::U, edge(r, rows));
+            for (int c = 0; c < cols; ++c) add_bend(r, c, 0, 1, Axis::U, bend_u(r, c));
         for (int r = 0; r < rows; ++r)
-            for (int c = 0; c < cols; ++c) add_bend(r, c, 1, 0, Axis::V, edge(c, cols));
+            for (int c = 0; c < cols; ++c) add_bend(r, c, 1, 0, Axis::V, bend_v(r, c));
     } else {
         for (int r = 0; r < rows; ++r)
-            for (int c = 0; c < cols; ++c) add(r, c, r, c + 2, SpringKind::Bending, Axis::U, 1.0f);
+            for (int c = 0; c < cols; ++c) add(r, c, r, c + 2, SpringKind::Bending, Axis::U, shape.has_particle(r, c + 1));
         for (int r = 0; r < rows; ++r)
-            for (int c = 0; c < cols; ++c) add(r, c, r + 2, c, SpringKind::Bending, Axis::V, 1.0f);
+            for (int c = 0; c < cols; ++c) add(r, c, r + 2, c, SpringKind::Bending, Axis::V, shape.has_particle(r + 1, c));
     }
 
-    // Two triangles per cell, wound so their normal is u_axis x v_axis.
+    // Two triangles per cell of the shape, wound so their normal is u_axis x v_axis.
     for (int r = 0; r + 1 < rows; ++r) {
         for (int c = 0; c + 1 < cols; ++c) {
+            if (!shape.has_cell(r, c)) continue;
             const auto i00 = static_cast<std::uint32_t>(t.index(r, c));
             const auto i01 = static_cast<std::uint32_t>(t.index(r, c + 1));
             const auto i10 = static_cast<std::uint32_t>(t.index(r + 1, c));
@@ -146,30 +163,37 @@ MassSpring build_simulation(const Scene& scene) {
             state.position.set(static_cast<std::size_t>(r) * cloth.cols + c, glm::dvec3(p));
         }
     }
+    const ShapeMask shape = shape_mask(cloth);
+    state.mass.assign(n, 0.0f);
     if (scene.material.enabled) {
         // Each cell's mass density x h_u x h_v goes a quarter to each corner (material.hpp).
         const glm::dvec2 h = grid_spacing(cloth);
         const double quarter = 0.25 * double(scene.material.density) * h.x * h.y;
-        state.mass.assign(n, 0.0f);
         for (int r = 0; r < cloth.rows; ++r) {
             for (int c = 0; c < cloth.cols; ++c) {
-                const int cells = (r > 0 ? 1 : 0) + (r + 1 < cloth.rows ? 1 : 0);
-                const int cells_across = (c > 0 ? 1 : 0) + (c + 1 < cloth.cols ? 1 : 0);
-                state.mass[static_cast<std::size_t>(r) * cloth.cols + c] = static_cast<float>(quarter * cells * cells_across);
+                const int cells = shape.has_cell(r - 1, c - 1) + shape.has_cell(r - 1, c) + shape.has_cell(r, c - 1) +
+                                  shape.has_cell(r, c);
+                state.mass[static_cast<std::size_t>(r) * cloth.cols + c] = static_cast<float>(quarter * cells);
             }
         }
     } else {
-        state.mass.assign(n, cloth.mass / static_cast<float>(n));
+        // The total shared equally by the particles of the shape.
+        const float share = cloth.mass / static_cast<float>(shape.particle_count);
+        for (std::size_t i = 0; i < n; ++i) state.mass[i] = shape.particle[i] ? share : 0.0f;
     }
     state.inverse_mass.resize(n);
-    for (std::size_t i = 0; i < n; ++i) state.inverse_mass[i] = 1.0f / state.mass[i];
     state.pinned.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        state.inverse_mass[i] = shape.particle[i] ? 1.0f / state.mass[i] : 0.0f;
+        if (!shape.particle[i]) state.pinned[i] = kAbsent;
+    }
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {
-        state.pinned[i] = 1;
+        if (state.pinned[i] == kAbsent) continue;  // a preset's pin outside a disc: nothing there to hold
+        state.pinned[i] = kPinned;
         state.inverse_mass[i] = 0.0f;
     }
     std::vector<glm::vec3> velocity(n, cloth.velocity);
-    Topology topology = grid_topology(cloth.rows, cloth.cols, state.position, scene.material.enabled);
+    Topology topology = grid_topology(shape, state.position, scene.material.enabled);
     // The springs' k from the material here too, for a scene changed in code after it was loaded.
     Scene derived = scene;
     derive_springs(derived);

@@ -264,37 +264,28 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
     }
     for (int d = 0; d < 6; ++d) {
         const Direction& dir = kDirections[d];
-        for (int r = 0; r < t.rows; ++r) {
-            for (int c = 0; c < t.cols; ++c) {
-                float& rest = solver.rest_[d][static_cast<std::size_t>(r) * t.cols + c];
-                const bool inside = r + dir.dr < t.rows && c >= first_column(dir) && c < end_column(dir, t.cols);
-                // A direction with some springs must have all: the sweep would add the missing ones.
-                if (inside && solver.present_[d] && std::isnan(rest)) return std::nullopt;
-                if (!inside || !solver.present_[d]) rest = 0.0f;
-            }
+        // A slot without an element in a direction that has some (a grid slot outside a disc, or an edge the
+        // shape leaves out) gets weight 0: the sweep computes it and scales it to nothing.
+        for (std::size_t i = 0; i < n; ++i) {
+            if (std::isnan(solver.rest_[d][i])) solver.rest_[d][i] = 0.0f, weight[d][i] = 0.0f;
         }
-        // The weights: the same along each row (scaling the row's k), or the same down each column (scaling
-        // the forces of those columns), for every element the direction has.
-        solver.row_weight_[d].assign(t.rows, 1.0f);
+        // Per row: the largest weight scales the row's k, the other columns' forces are scaled by their
+        // weight over it (powers of two: exact) afterwards.
         const int c0 = first_column(dir), c1 = end_column(dir, t.cols);
-        const int r1 = t.rows - dir.dr;
-        auto w = [&](int r, int c) { return weight[d][static_cast<std::size_t>(r) * t.cols + c]; };
-        bool by_row = true, by_column = true;
-        for (int r = 0; r < r1; ++r) {
+        solver.row_weight_[d].assign(t.rows, 1.0f);
+        solver.fix_begin_[d].assign(t.rows + 1, 0);
+        for (int r = 0; r < t.rows; ++r) {
+            solver.fix_begin_[d][r] = static_cast<int>(solver.fixes_[d].size());
+            if (!solver.present_[d] || r + dir.dr >= t.rows || c1 <= c0) continue;
+            const float* w = weight[d].data() + static_cast<std::size_t>(r) * t.cols;
+            const float base = *std::max_element(w + c0, w + c1);
+            solver.row_weight_[d][r] = base;
+            if (base == 0.0f) continue;
             for (int c = c0; c < c1; ++c) {
-                by_row = by_row && w(r, c) == w(r, c0);
-                by_column = by_column && w(r, c) == w(0, c);
+                if (w[c] != base) solver.fixes_[d].emplace_back(c, w[c] / base);
             }
         }
-        if (by_row) {
-            for (int r = 0; r < r1 && c1 > c0; ++r) solver.row_weight_[d][r] = w(r, c0);
-        } else if (by_column) {
-            for (int c = c0; c < c1 && r1 > 0; ++c) {
-                if (w(0, c) != 1.0f) solver.column_weight_[d].emplace_back(c, w(0, c));
-            }
-        } else {
-            return std::nullopt;
-        }
+        solver.fix_begin_[d][t.rows] = static_cast<int>(solver.fixes_[d].size());
     }
     return solver;
 }
@@ -374,7 +365,8 @@ struct Grid {
     const std::array<std::vector<float>, 6>& rest;
     const std::array<bool, 6>& present;
     const std::array<std::vector<float>, 6>& row_weight;
-    const std::array<std::vector<std::pair<int, float>>, 6>& column_weight;
+    const std::array<std::vector<int>, 6>& fix_begin;
+    const std::array<std::vector<std::pair<int, float>>, 6>& fixes;
     std::size_t stride() const { return static_cast<std::size_t>(cols) + 2 * kPad; }
     // Spring-row storage: 18 rows (direction, component) of `stride` floats, column c at [kPad + c].
     std::size_t row_floats() const { return 18 * stride(); }
@@ -429,7 +421,8 @@ template <FastKernel K, unsigned Mask>
             spring_forces_generic(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
                                   f + 2 * stride + c0);
         }
-        for (const auto& [c, w] : grid.column_weight[d]) {
+        for (int i = grid.fix_begin[d][r]; i < grid.fix_begin[d][r + 1]; ++i) {
+            const auto [c, w] = grid.fixes[d][i];
             f[c] *= w, f[stride + c] *= w, f[2 * stride + c] *= w;
         }
     }
@@ -617,13 +610,13 @@ constexpr std::array<SweepFn, 16> sweep_table(FastKernel kernel, std::index_sequ
 }  // namespace
 
 void FastSolver::spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const {
-    const Grid grid{rows_, cols_, rest_, present_, row_weight_, column_weight_};
+    const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
     spring_row_table(kernel_in_use(), std::make_index_sequence<16>())[mask & 15u](grid, state, springs, r, out);
 }
 
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
-    const Grid grid{rows_, cols_, rest_, present_, row_weight_, column_weight_};
+    const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
                         sweep.row_boxes, scratch.window.data(), zeros_.data()};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);

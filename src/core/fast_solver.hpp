@@ -6,9 +6,9 @@
 //    from the start along (0,+1) or (+1,0)). The elements of one direction starting in one row are a
 //    contiguous run of particles paired with shifted runs, so their forces are computed by one vector loop
 //    (AVX-512 or AVX2 + FMA when the CPU has it, chosen at run time; plain C++ otherwise), each once.
-//  - Weights (spring.hpp) that vary by row scale the row's k; weights that vary by column scale the
-//    computed forces of those columns afterwards. Both are powers of two, so the result is the textbook's
-//    k w product bit for bit.
+//  - Weights (spring.hpp): the largest in a row scales the row's k; the columns whose weight differs (the
+//    cloth's edge, slots outside a disc, where the weight is 0) scale their computed forces afterwards. All
+//    are powers of two or 0, so the result is the textbook's k w product bit for bit.
 //  - One pass over the rows does everything a substep needs. Row q's force is complete once the spring
 //    rows q-2, q-1 and q are computed, and no later spring reads row q, so the sweep gathers row q's force
 //    from those three spring rows (kept in a rolling window that stays in L1/L2), integrates it in place
@@ -41,8 +41,7 @@ enum class FastKernel { Generic, Avx2, Avx512 };
 class FastSolver {
 public:
     // Nullopt when the topology is not a rows x cols grid whose springs and bends all run in the six
-    // directions, each direction either complete or absent, with weights that vary only by row or only by
-    // column in each direction.
+    // directions (at most one per slot, weights powers of two or 0).
     static std::optional<FastSolver> for_topology(const Topology& topology);
 
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
@@ -87,8 +86,11 @@ private:
     std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
     bool bends_ = false;                       // directions 4 and 5 are bends, not skip-one springs
-    std::array<std::vector<float>, 6> row_weight_;                      // weight of direction d's springs in row r
-    std::array<std::vector<std::pair<int, float>>, 6> column_weight_;  // (column, weight) where not 1, every row
+    std::array<std::vector<float>, 6> row_weight_;  // the largest weight of direction d's elements in row r
+    // (column, weight / row weight) of the elements of row r that differ: fixes_[d][fix_begin_[d][r] ...
+    // fix_begin_[d][r + 1]).
+    std::array<std::vector<int>, 6> fix_begin_;
+    std::array<std::vector<std::pair<int, float>>, 6> fixes_;
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
     std::vector<float> boundary_;              // spring rows just above block boundaries

@@ -451,17 +451,18 @@ bool MassSpring::all_finite() const {
 }
 
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
+    if (state_.pinned.at(i) == kAbsent) return;  // outside the cloth's shape: no particle to pin or free
     if (pinned && grab_ && grab_->particle == i) release_grab();
     wake();
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
-    state_.pinned.at(i) = pinned ? 1 : 0;
+    state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
 }
 
 void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
-    if (!state_.pinned.at(i)) return;
+    if (state_.pinned.at(i) != kPinned) return;
     wake();
     stamp_ = next_stamp();
     state_.position.set(i, glm::dvec3(position));

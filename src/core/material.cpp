@@ -1,5 +1,6 @@
 #include "clothsim/material.hpp"
 
+#include "clothsim/cloth_shape.hpp"
 #include "clothsim/scene.hpp"
 
 #include <array>
@@ -108,7 +109,7 @@ SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSetti
     out.bending = {double(material.bending.x) * hv / (hu * hu * hu), double(material.bending.y) * hu / (hv * hv * hv)};
     out.poisson_uv = g / c22;
     out.poisson_vu = g / c11;
-    out.total_mass = double(material.density) * double(cloth.size.x) * double(cloth.size.y);
+    out.total_mass = double(material.density) * hu * hv * double(shape_mask(cloth).cell_count);
     return out;
 }
 

@@ -31,6 +31,7 @@ const std::array kFields = {
     FieldInfo{"cloth.origin", "m", -kBig, kBig, "position of particle (row 0, col 0)", [](Scene& s) -> FieldRef { return &s.cloth.origin; }},
     FieldInfo{"cloth.u_axis", "", -1e3, 1e3, "direction of increasing column (normalised; not parallel to v_axis)", [](Scene& s) -> FieldRef { return &s.cloth.u_axis; }},
     FieldInfo{"cloth.v_axis", "", -1e3, 1e3, "direction of increasing row (normalised)", [](Scene& s) -> FieldRef { return &s.cloth.v_axis; }},
+    FieldInfo{"cloth.shape", "", 0, 0, "rectangle: the whole grid; disc: the particles inside the grid's inscribed circle (a Cusick drape specimen)", [](Scene& s) -> FieldRef { return &s.cloth.shape; }},
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
     FieldInfo{"material.preset", "", 0, 0, "a measured fabric (cotton, denim, silk, wool-jersey, polyester) that fills the material fields this scene does not set", [](Scene& s) -> FieldRef { return &s.material.preset; }},
@@ -90,6 +91,7 @@ constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textboo
 constexpr std::array<std::string_view, 5> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
                                                                "xpbd"};
 constexpr std::array<std::string_view, 2> kContactModelNames = {"projection", "penalty"};
+constexpr std::array<std::string_view, 2> kClothShapeNames = {"rectangle", "disc"};
 
 // Shortest text that reads back to the same float (std::to_chars), so 0.2f prints as 0.2, not 0.200000003.
 std::string number(double v) {
@@ -127,6 +129,7 @@ std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
 std::span<const std::string_view> solver_method_names() { return kSolverMethodNames; }
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
 std::span<const std::string_view> contact_model_names() { return kContactModelNames; }
+std::span<const std::string_view> cloth_shape_names() { return kClothShapeNames; }
 
 std::string describe_pin_radius() { return cat("a number in [0.0, ", number(kMaxPinRadius), "] m"); }
 

@@ -332,13 +332,15 @@ void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projec
     glDisable(GL_DEPTH_TEST);
     if (view.particles) {
         lines_.set("u_point_size", 4.0f);
-        for (std::size_t i = 0; i < sim.particle_count(); ++i) debug_.push_back({positions[i], {0.1f, 0.1f, 0.1f, 1.0f}});
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+            if (sim.state().pinned[i] != kAbsent) debug_.push_back({positions[i], {0.1f, 0.1f, 0.1f, 1.0f}});
+        }
         flush(GL_POINTS);
     }
     if (view.highlight_pins) {
         lines_.set("u_point_size", 9.0f);
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-            if (sim.state().pinned[i] && i != input.grabbed) debug_.push_back({positions[i], {0.9f, 0.1f, 0.1f, 1.0f}});
+            if (sim.state().pinned[i] == kPinned && i != input.grabbed) debug_.push_back({positions[i], {0.9f, 0.1f, 0.1f, 1.0f}});
         }
         flush(GL_POINTS);
     }

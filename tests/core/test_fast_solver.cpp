@@ -135,8 +135,19 @@ TEST_CASE("fast solver is only used for grid topologies; others run the textbook
     CHECK_FALSE(FastSolver::for_topology(t).has_value());
     t.springs = {{0, 1, 1.0f, SpringKind::Structural}, {1, 0, 1.0f, SpringKind::Structural}};  // a duplicate
     CHECK_FALSE(FastSolver::for_topology(t).has_value());
-    t.springs = {{0, 1, 1.0f, SpringKind::Structural}};  // the spring (1, 2) is missing
+    // A missing spring is a slot of weight 0 (a disc's outline): still a grid.
+    t.springs = {{0, 1, 1.0f, SpringKind::Structural}};
+    CHECK(FastSolver::for_topology(t).has_value());
+    t.springs = {{0, 1, 1.0f, SpringKind::Structural, Axis::U, 0.3f}};  // a weight that is no power of two
     CHECK_FALSE(FastSolver::for_topology(t).has_value());
+    t.springs.clear();
+    t.bends = {{0, 2, 1, Axis::U, 1.0f}};  // a bend whose middle is not between its ends
+    CHECK_FALSE(FastSolver::for_topology(t).has_value());
+    t.bends = {{0, 1, 2, Axis::U, 1.0f}};
+    CHECK(FastSolver::for_topology(t).has_value());
+    t.springs = {{0, 2, 2.0f, SpringKind::Bending}};  // skip-one springs and bends both
+    CHECK_FALSE(FastSolver::for_topology(t).has_value());
+    t.bends.clear();
     t.springs = {{1, 0, 1.0f, SpringKind::Structural}, {2, 1, 1.0f, SpringKind::Structural},
                  {0, 2, 2.0f, SpringKind::Bending}};  // either end may come first
     CHECK(FastSolver::for_topology(t).has_value());

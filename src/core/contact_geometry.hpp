@@ -73,13 +73,21 @@ template <class T>
 Contact<T> contact(const CylinderCollider& cylinder, glm::vec<3, T> p, T thickness) {
     using Vec = glm::vec<3, T>;
     const Vec local = p - Vec(cylinder.center);
-    const T r = std::sqrt(local.x * local.x + local.z * local.z);
+    Contact<T> c;
+    // Clearly outside the shell's own bounding cylinder (by a relative 1e-5, as for the sphere): no contact,
+    // no square root. The depth says only what is known without it: at least at the shell (0).
+    const T r2 = local.x * local.x + local.z * local.z;
+    const T reach_r = T(cylinder.radius) + thickness, reach_y = T(0.5) * T(cylinder.height) + thickness;
+    if (r2 > reach_r * reach_r * T(1.00001) || std::abs(local.y) > reach_y * T(1.00001)) {
+        c.depth = T(0);
+        return c;
+    }
+    const T r = std::sqrt(r2);
     // Outward from the axis; a particle on the axis has no direction: +x.
     const Vec radial = r > T(1e-12f) ? Vec(local.x / r, T(0), local.z / r) : Vec(T(1), T(0), T(0));
     const Vec vertical(T(0), local.y < T(0) ? T(-1) : T(1), T(0));  // toward the nearer face
     const T side = r - T(cylinder.radius);                            // > 0 beyond the side
     const T face = std::abs(local.y) - T(0.5) * T(cylinder.height);  // > 0 beyond the nearer face
-    Contact<T> c;
     if (side > T(0) || face > T(0)) {
         const T s = std::max(side, T(0)), f = std::max(face, T(0));
         const T distance = s > T(0) && f > T(0) ? std::sqrt(s * s + f * f) : s + f;

@@ -70,8 +70,8 @@ long long rss_kib() {
 double energy_bound(double e0) { return e0 + std::fabs(e0) + 1.0; }
 
 // Where a sane cloth can be. A free cloth cannot reach farther from its start than its own diagonal plus
-// what it slides; we allow the start box (and the enabled sphere and cube) grown by twice the diagonal on
-// every side. It must not fall through the ground nor sink into the sphere or the cube: the collision stage
+// what it slides; we allow the start box (and the enabled colliders) grown by twice the diagonal on every
+// side. It must not fall through the ground nor sink into the sphere, the cube or the cylinder: the collision stage
 // keeps every particle `thickness` (5 mm) outside each surface after every substep, so a particle more than
 // kPenetration inside one has leaked through it. And no spring may be stretched past the guard's blow-up
 // strain (GuardSettings::max_strain, 1000%): a cloth that far from rest has blown up even if it is finite.
@@ -82,7 +82,7 @@ struct Bounds {
 };
 
 Bounds sane_bounds(const MassSpring& sim) {
-    // The start cloth, the enabled sphere and cube, and down to the ground: what the app frames.
+    // The start cloth, the enabled sphere, cube and cylinder, and down to the ground: what the app frames.
     glm::vec3 lo, hi;
     scene_bounds(sim, lo, hi);
     // The cloth's diagonal: the largest distance between two particles of an unstretched cloth.
@@ -107,6 +107,8 @@ std::string bounds_violation(const MassSpring& sim, const Bounds& b, double stra
             what = "inside the sphere";
         } else if (c.cube.enabled && (depth = -signed_distance(c.cube, p)) > kPenetration) {
             what = "inside the cube";
+        } else if (c.cylinder.enabled && (depth = -signed_distance(c.cylinder, p)) > kPenetration) {
+            what = "inside the cylinder";
         }
         if (what) {
             std::snprintf(buf, sizeof buf, "particle %zu at (%.4g, %.4g, %.4g) %s", i, p.x, p.y, p.z, what);
@@ -142,6 +144,7 @@ std::string enabled_colliders(const ColliderSettings& c) {
     std::string s;
     if (c.sphere.enabled) s += "sphere ";
     if (c.cube.enabled) s += "cube ";
+    if (c.cylinder.enabled) s += "cylinder ";
     if (c.ground.enabled) s += "ground ";
     if (s.empty()) return "none";
     s.pop_back();

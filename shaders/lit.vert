@@ -1,5 +1,5 @@
 #version 330 core
-// Lit geometry (cloth, sphere, cube, ground): world-space position and normal, UVs, light-space position.
+// Lit geometry (cloth, sphere, cube, cylinder, ground): world-space position and normal, UVs, light-space position.
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;

@@ -44,6 +44,7 @@ inline std::size_t blocks_per_row(int cols) { return (static_cast<std::size_t>(c
 // Whether a particle in `box` can come closer than `thickness` to the collider's surface.
 bool may_touch(const SphereCollider& sphere, float thickness, const Box& box);
 bool may_touch(const CubeCollider& cube, float thickness, const Box& box);
+bool may_touch(const CylinderCollider& cylinder, float thickness, const Box& box);
 bool may_touch(const GroundCollider& ground, float thickness, const Box& box);
 
 }  // namespace clothsim

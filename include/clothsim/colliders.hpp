@@ -1,17 +1,18 @@
-// Collision with a sphere, an axis-aligned box and the ground plane: the projection contact model
-// (colliders.contact = projection, the default; penalty_contact.hpp in src/core has the smooth force model).
+// Collision with a sphere, an axis-aligned box, a vertical cylinder and the ground plane: the projection
+// contact model (colliders.contact = projection, the default; penalty_contact.hpp in src/core has the smooth
+// force model).
 //
 // After integration every free particle closer than `thickness` to a collider surface is projected out
-// to that distance along the surface normal (the box: along the shortest way out). The contact is
-// inelastic: the inward part of the substep's motion is removed, and the push itself adds no velocity.
-// Friction acts on the tangential motion like Coulomb friction in position-based dynamics (Mueller et
-// al. 2007, Macklin et al. 2014): it is reduced by at most mu times the normal correction, and stops
+// to that distance along the surface normal (the box and the cylinder: along the shortest way out). The
+// contact is inelastic: the inward part of the substep's motion is removed, and the push itself adds no
+// velocity. Friction acts on the tangential motion like Coulomb friction in position-based dynamics (Mueller
+// et al. 2007, Macklin et al. 2014): it is reduced by at most mu times the normal correction, and stops
 // when it is smaller (static friction). A particle resting on a plane is pushed
 // back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
 //
-// Continuous collision: a particle whose path over the substep (x - motion -> x) went through the sphere or
-// the box, though it ends outside (or inside, past the middle), is stopped where the path entered the
-// thickness shell, its inward motion removed. The ground is a half-space and needs no sweep.
+// Continuous collision: a particle whose path over the substep (x - motion -> x) went through the sphere, the
+// box or the cylinder, though it ends outside (or inside, past the middle), is stopped where the path entered
+// the thickness shell, its inward motion removed. The ground is a half-space and needs no sweep.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"
@@ -28,6 +29,7 @@ namespace clothsim {
 // Signed distance from p to the collider surface (m): negative inside.
 float signed_distance(const SphereCollider& sphere, glm::vec3 p);
 float signed_distance(const CubeCollider& cube, glm::vec3 p);
+float signed_distance(const CylinderCollider& cylinder, glm::vec3 p);
 float signed_distance(const GroundCollider& ground, glm::vec3 p);
 
 // Collision stages for particles [begin, end) (all by default). Pinned particles are never moved.
@@ -36,9 +38,11 @@ void collide(State& state, const SphereCollider& sphere, float thickness, std::s
              std::size_t end = kAllParticles);
 void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
+void collide(State& state, const CylinderCollider& cylinder, float thickness, std::size_t begin = 0,
+             std::size_t end = kAllParticles);
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
-// Every enabled collider, in the order sphere, cube, ground, testing every particle (the reference solution).
+// Every enabled collider, in the order sphere, cube, cylinder, ground, testing every particle (the reference solution).
 void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
 

@@ -3,7 +3,7 @@
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind, penalty contact, the user's grab), integrate (gravity and damping inside),
-// collide (the projection contact: sphere, cube, ground), limit strain and speed, and once per step see whether
+// collide (the projection contact: sphere, cube, cylinder, ground), limit strain and speed, and once per step see whether
 // the cloth may sleep. colliders.contact picks penalty contact (a force) or projection (a stage after). Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
 // Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,
@@ -204,9 +204,9 @@ private:
     Vec3Array grab_external_;    // N: the grab's force alone (zero but for the grabbed particle), for the fast solver
 };
 
-// The box around the cloth's finite particles, the enabled sphere and cube, and down to the ground when it
-// is enabled (where a falling cloth ends up): what the camera frames and the shadow map covers. An empty
-// or all-NaN cloth gives the box at the origin (and the ground).
+// The box around the cloth's finite particles, the enabled sphere, cube and cylinder, and down to the ground
+// when it is enabled (where a falling cloth ends up): what the camera frames and the shadow map covers. An
+// empty or all-NaN cloth gives the box at the origin (and the ground).
 void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi);
 
 }  // namespace clothsim

@@ -137,6 +137,17 @@ struct CubeCollider {
     bool operator==(const CubeCollider&) const = default;
 };
 
+// A solid cylinder with a vertical axis, such as the support disc of the Cusick drape tester (ISO 9073-9,
+// BS 5058: an 18 cm disc). Its flat top is at center.y + height / 2, its flat bottom at center.y - height / 2.
+struct CylinderCollider {
+    bool enabled = false;
+    glm::vec3 center{0.0f, 0.25f, 0.0f};  // m: the middle of the axis
+    float radius = 0.09f;                 // m
+    float height = 0.5f;                  // m: from the bottom face to the top face
+    float friction = 0.3f;
+    bool operator==(const CylinderCollider&) const = default;
+};
+
 struct GroundCollider {
     bool enabled = true;
     float height = 0.0f;     // m: the plane y = height
@@ -147,6 +158,7 @@ struct GroundCollider {
 struct ColliderSettings {
     SphereCollider sphere;
     CubeCollider cube;
+    CylinderCollider cylinder;
     GroundCollider ground;
     float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
     ContactModel contact = ContactModel::Projection;

@@ -3,9 +3,9 @@
 // MassSpring builds the plan when it is constructed and again whenever its settings change (it compares
 // them with the ones the plan was made for, once per substep), never per particle. A stage that would do
 // nothing is not run at all: a spring kind with stiffness 0 or no springs, zero wind, a disabled collider,
-// no strain or speed limit. The contact model picks the colliders' stages: projection runs the sphere, cube
-// and ground stages after integration; penalty contact runs none of them and adds a force stage ("contact")
-// beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
+// no strain or speed limit. The contact model picks the colliders' stages: projection runs the sphere, cube,
+// cylinder and ground stages after integration; penalty contact runs none of them and adds a force stage
+// ("contact") beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
 // costs no instruction in the hot loop (src/core/fast_solver.cpp). Gravity and damping are coefficients of
 // the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
 #pragma once
@@ -32,13 +32,13 @@ struct StepPlan {
     std::array<bool, kSpringKindCount> springs{};  // a kind runs: it has springs and a non-zero stiffness
     bool wind = false;
     bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)
-    bool sphere = false, cube = false, ground = false;  // the projection stages (colliders.contact = projection)
+    bool sphere = false, cube = false, cylinder = false, ground = false;  // the projection stages (projection contact)
     bool strain_limit = false;
     bool speed_limit = false;
     bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth
 
     bool any_springs() const { return springs[0] || springs[1] || springs[2]; }
-    bool any_collider() const { return sphere || cube || ground; }
+    bool any_collider() const { return sphere || cube || cylinder || ground; }
     // Bit k set when spring kind k runs: the fast solver's variant.
     unsigned spring_mask() const { return (springs[0] ? 1u : 0u) | (springs[1] ? 2u : 0u) | (springs[2] ? 4u : 0u); }
 };

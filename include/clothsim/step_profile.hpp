@@ -21,6 +21,7 @@ enum class Stage {
     BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth
     Sphere,      // sphere collisions (broad and narrow phase; projection contact)
     Cube,        // cube collisions
+    Cylinder,    // cylinder collisions
     Ground,      // ground collisions
     StrainLimit, // Provot's strain limit
     SpeedLimit,  // the max_speed clamp
@@ -32,19 +33,25 @@ inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count
 // Lower-case names, as the panel and the JSON show them.
 std::string_view stage_name(Stage stage);
 
-// The collider a stage times, as an index of StepProfile's block counts (0 sphere, 1 cube, 2 ground), or -1.
+// The collider a stage times, as an index of StepProfile's block counts (0 sphere, 1 cube, 2 cylinder,
+// 3 ground), or -1.
+inline constexpr std::size_t kColliderCount = 4;
 constexpr int collider_index(Stage stage) {
-    return stage == Stage::Sphere ? 0 : stage == Stage::Cube ? 1 : stage == Stage::Ground ? 2 : -1;
+    return stage == Stage::Sphere     ? 0
+           : stage == Stage::Cube     ? 1
+           : stage == Stage::Cylinder ? 2
+           : stage == Stage::Ground   ? 3
+                                      : -1;
 }
 
 struct StepProfile {
     std::array<double, kStageCount> ms{};         // wall time spent in each stage
     std::array<long long, kStageCount> runs{};    // times the stage ran: once a substep (colliders twice when a
                                                   // strain or speed limit runs; Sleep once a step)
-    // Collision broad phase, per collider (sphere, cube, ground): particle blocks whose box met the collider
-    // and were tested particle by particle, out of all blocks offered to it.
-    std::array<long long, 3> blocks_tested{};
-    std::array<long long, 3> blocks_offered{};
+    // Collision broad phase, per collider (collider_index: sphere, cube, cylinder, ground): particle blocks
+    // whose box met the collider and were tested particle by particle, out of all blocks offered to it.
+    std::array<long long, kColliderCount> blocks_tested{};
+    std::array<long long, kColliderCount> blocks_offered{};
     long long substeps = 0;         // substeps stepped
     long long slept_substeps = 0;   // substeps skipped because the cloth was asleep
 

@@ -508,6 +508,9 @@ void colliders_section(Scene& edit, AppState& app) {
     ImGui::TextDisabled("cube");
     fields_section(edit, app, "colliders.cube.");
     ImGui::Separator();
+    ImGui::TextDisabled("cylinder");
+    fields_section(edit, app, "colliders.cylinder.");
+    ImGui::Separator();
     ImGui::TextDisabled("ground");
     fields_section(edit, app, "colliders.ground.");
     fields_section(edit, app, "colliders.thickness");

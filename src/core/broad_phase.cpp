@@ -2,6 +2,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 
 #include <immintrin.h>
 
@@ -141,6 +142,22 @@ bool may_touch(const CubeCollider& cube, float thickness, const Box& box) {
     const glm::vec3 lo = cube.center - half - grow, hi = cube.center + half + grow;
     return box.lo.x < hi.x && box.hi.x > lo.x && box.lo.y < hi.y && box.hi.y > lo.y && box.lo.z < hi.z &&
            box.hi.z > lo.z;
+}
+
+bool may_touch(const CylinderCollider& cylinder, float thickness, const Box& box) {
+    if (box.empty()) return false;
+    // Along the axis: the slab between the faces, each moved out by the thickness, meets the box's y range.
+    const float half = 0.5f * cylinder.height + thickness;
+    const float grow_y = margin(std::abs(cylinder.center.y) + half + std::abs(box.lo.y) + std::abs(box.hi.y));
+    if (!(box.lo.y < cylinder.center.y + half + grow_y && box.hi.y > cylinder.center.y - half - grow_y)) return false;
+    // Across it: the box's x-z rectangle comes within radius + thickness of the axis (the sphere's test in 2D).
+    const glm::vec2 axis(cylinder.center.x, cylinder.center.z);
+    const glm::vec2 nearest = glm::clamp(axis, glm::vec2(box.lo.x, box.lo.z), glm::vec2(box.hi.x, box.hi.z));
+    const glm::vec2 d = axis - nearest;
+    const float reach = cylinder.radius + thickness;
+    const float scale = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(nearest.x), std::abs(nearest.y)});
+    const float grown = reach + margin(reach + 4.0f * scale);
+    return glm::dot(d, d) < grown * grown;
 }
 
 bool may_touch(const GroundCollider& ground, float thickness, const Box& box) {

@@ -4,6 +4,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -83,6 +84,75 @@ std::optional<SweptHit<T>> swept_hit(const CubeCollider& cube, glm::vec<3, T> p0
     hit.t = entry->first;
     hit.normal = glm::vec<3, T>(T(0));
     hit.normal[entry->second] = d[entry->second] > T(0) ? T(-1) : T(1);
+    return hit;
+}
+
+// The segment p0 -> p0 + d (p0 relative to the centre) against the cylinder grown by `grow` (radius + grow,
+// each face moved out by grow: flat, like the box's): the entry t and the surface it enters through, 0 a face,
+// 1 the side, -1 none (it starts inside). The intersection of the slab between the faces with the infinite
+// cylinder around the axis, each an interval of t.
+template <class T>
+std::optional<std::pair<T, int>> enter_cylinder(const CylinderCollider& cylinder, glm::vec<3, T> p0,
+                                                glm::vec<3, T> d, T grow) {
+    T near = T(0), far = T(1);
+    int surface = -1;
+    const T half = T(0.5) * T(cylinder.height) + grow;
+    if (d.y == T(0)) {
+        if (std::abs(p0.y) > half) return std::nullopt;
+    } else {
+        T t0 = (-half - p0.y) / d.y, t1 = (half - p0.y) / d.y;
+        if (t0 > t1) std::swap(t0, t1);
+        if (t0 > near) {
+            near = t0;
+            surface = 0;
+        }
+        far = std::min(far, t1);
+    }
+    const T radius = T(cylinder.radius) + grow;
+    const T a = d.x * d.x + d.z * d.z;
+    const T c = p0.x * p0.x + p0.z * p0.z - radius * radius;
+    if (!(a > T(0))) {
+        if (c > T(0)) return std::nullopt;  // moving along the axis, beside the cylinder
+    } else {
+        const T b = p0.x * d.x + p0.z * d.z;
+        const T disc = b * b - a * c;
+        if (!(disc >= T(0))) return std::nullopt;
+        const T root = std::sqrt(disc);
+        const T t0 = (-b - root) / a, t1 = (-b + root) / a;
+        if (t0 > near) {
+            near = t0;
+            surface = 1;
+        }
+        far = std::min(far, t1);
+    }
+    if (!(near <= far)) return std::nullopt;
+    return std::pair<T, int>(near, surface);
+}
+
+template <class T>
+std::optional<SweptHit<T>> swept_hit(const CylinderCollider& cylinder, glm::vec<3, T> p0, glm::vec<3, T> p1,
+                                     T thickness) {
+    using Vec = glm::vec<3, T>;
+    const Vec f = p0 - Vec(cylinder.center), d = p1 - p0;
+    if (!enter_cylinder(cylinder, f, d, T(0))) return std::nullopt;
+    const auto entry = enter_cylinder(cylinder, f, d, thickness);
+    if (!entry) return std::nullopt;
+    SweptHit<T> hit;
+    if (entry->second < 0) {
+        // Starts inside the flat-grown cylinder but outside the shell (collide_shape checked): beside a rim,
+        // where the shell is rounded. It stops where it is, its motion toward the rim removed.
+        hit.t = T(0);
+        hit.normal = contact(cylinder, p0, thickness).normal;
+        return hit;
+    }
+    hit.t = entry->first;
+    if (entry->second == 0) {
+        hit.normal = Vec(T(0), d.y > T(0) ? T(-1) : T(1), T(0));
+    } else {
+        const Vec at = f + hit.t * d;
+        const T r = std::sqrt(at.x * at.x + at.z * at.z);
+        hit.normal = r > T(1e-12f) ? Vec(at.x / r, T(0), at.z / r) : Vec(T(1), T(0), T(0));
+    }
     return hit;
 }
 
@@ -184,6 +254,13 @@ float signed_distance(const CubeCollider& cube, glm::vec3 p) {
     return glm::length(glm::max(q, glm::vec3(0.0f))) + std::min(std::max({q.x, q.y, q.z}), 0.0f);
 }
 
+float signed_distance(const CylinderCollider& cylinder, glm::vec3 p) {
+    const glm::vec3 local = p - cylinder.center;
+    const glm::vec2 q(std::sqrt(local.x * local.x + local.z * local.z) - cylinder.radius,
+                      std::abs(local.y) - 0.5f * cylinder.height);
+    return glm::length(glm::max(q, glm::vec2(0.0f))) + std::min(std::max(q.x, q.y), 0.0f);
+}
+
 float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
 
 void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
@@ -192,6 +269,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     const T thickness = colliders.thickness;
     if (colliders.sphere.enabled) collide_shape(state, colliders.sphere, T(colliders.sphere.friction), thickness, begin, end);
     if (colliders.cube.enabled) collide_shape(state, colliders.cube, T(colliders.cube.friction), thickness, begin, end);
+    if (colliders.cylinder.enabled) collide_shape(state, colliders.cylinder, T(colliders.cylinder.friction), thickness, begin, end);
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
 void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
@@ -201,7 +279,8 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.current = blocks.boxes_current = false;
     }
     const std::size_t count = blocks.count();
-    const bool any = colliders.sphere.enabled || colliders.cube.enabled || colliders.ground.enabled;
+    const bool any =
+        colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled || colliders.ground.enabled;
     if (!any) return;
     if (!broad_phase) {
         blocks.boxes.resize(count);  // only counted: every block is tested
@@ -211,11 +290,11 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         const bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
         blocks.boxes.resize(count);
         // Swept boxes: grown by the cloth's largest motion per axis, they also hold where the substep started
-        // (x - motion), so a particle that passed through the sphere or the cube in one substep is still
+        // (x - motion), so a particle that passed through the sphere, the cube or the cylinder in one substep is still
         // offered to it (continuous collision). One bound for the cloth costs one vectorised pass, not one
         // per block; the ground (a half-space: nothing passes through it unseen) needs none.
         glm::vec3 reach(0.0f);
-        if (colliders.sphere.enabled || colliders.cube.enabled) {
+        if (colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled) {
             const Box motion = particle_bounds(state.motion, 0, state.size());
             if (!motion.empty()) reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
         }
@@ -241,6 +320,10 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         StageTimer timer(profile, Stage::Cube);
         collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
     }
+    if (colliders.cylinder.enabled) {
+        StageTimer timer(profile, Stage::Cylinder);
+        collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), profile);
+    }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
         collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
@@ -252,6 +335,9 @@ void collide(State& state, const SphereCollider& sphere, float thickness, std::s
 }
 void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
     collide_shape(state, cube, double(cube.friction), double(thickness), begin, std::min(end, state.size()));
+}
+void collide(State& state, const CylinderCollider& cylinder, float thickness, std::size_t begin, std::size_t end) {
+    collide_shape(state, cylinder, double(cylinder.friction), double(thickness), begin, std::min(end, state.size()));
 }
 void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
     collide_shape(state, ground, double(ground.friction), double(thickness), begin, std::min(end, state.size()));

@@ -496,6 +496,11 @@ void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi) {
         lo = glm::min(lo, c.cube.center - 0.5f * c.cube.size);
         hi = glm::max(hi, c.cube.center + 0.5f * c.cube.size);
     }
+    if (c.cylinder.enabled) {
+        const glm::vec3 half(c.cylinder.radius, 0.5f * c.cylinder.height, c.cylinder.radius);
+        lo = glm::min(lo, c.cylinder.center - half);
+        hi = glm::max(hi, c.cylinder.center + half);
+    }
     if (!(lo.x <= hi.x)) lo = hi = glm::vec3(0.0f);
     if (c.ground.enabled) {
         lo.y = std::min(lo.y, c.ground.height);

@@ -8,7 +8,7 @@ namespace clothsim {
 namespace {
 
 // Calls visit(contact) for each enabled collider the particle at p touches (depth > 0), sphere, cube,
-// ground in that order.
+// cylinder, ground in that order.
 template <class Visit>
 void for_each_contact(const ColliderSettings& colliders, glm::dvec3 p, Visit visit) {
     const double t = colliders.thickness;
@@ -17,6 +17,9 @@ void for_each_contact(const ColliderSettings& colliders, glm::dvec3 p, Visit vis
     }
     if (colliders.cube.enabled) {
         if (const Contact<double> c = contact(colliders.cube, p, t); c.depth > 0.0) visit(c);
+    }
+    if (colliders.cylinder.enabled) {
+        if (const Contact<double> c = contact(colliders.cylinder, p, t); c.depth > 0.0) visit(c);
     }
     if (colliders.ground.enabled) {
         if (const Contact<double> c = contact(colliders.ground, p, t); c.depth > 0.0) visit(c);
@@ -61,7 +64,8 @@ double contact_potential_energy(const State& state, const ColliderSettings& coll
 }
 
 double contact_stiffness_bound(const ColliderSettings& colliders) {
-    const int enabled = int(colliders.sphere.enabled) + int(colliders.cube.enabled) + int(colliders.ground.enabled);
+    const int enabled = int(colliders.sphere.enabled) + int(colliders.cube.enabled) + int(colliders.cylinder.enabled) +
+                        int(colliders.ground.enabled);
     return 3.0 * double(colliders.contact_stiffness) * enabled;
 }
 

@@ -11,6 +11,11 @@
 //    straddles the onset loses RK4 no order (its local error stays O(h^4) at the finitely many onsets,
 //    hence global O(h^4); Hairer, Norsett & Wanner, "Solving ODEs I", II.6 on discontinuities). A linear
 //    penalty k p has a kink in F (order drops to 2), the projection an impulse (order 0 in position).
+//    The geometry keeps that smoothness on a face, the sphere and the cylinder's side, and in the round shell
+//    around a box edge or a cylinder rim, but not where those meet: there the depth's curvature jumps (0 on
+//    the face's side, 1/distance on the rim's), so F is continuous with a jump in its derivative. A particle
+//    that crosses such a plane while in the shell (it slides off a face over a rim) loses RK4's order there,
+//    not conservation (measured at a cylinder rim: test_contact_penalty.cpp).
 //  - A nonlinear power law, as in Hertz's contact (F ~ p^(3/2); Johnson, "Contact Mechanics", 1985, 4.2)
 //    and in the Hunt & Crossley model (F = k p^n + lambda p^n p'; Hunt & Crossley 1975, J. Appl. Mech.
 //    42(2)), with the exponent n = 3 chosen for smoothness rather than fitted to a material, and without

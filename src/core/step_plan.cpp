@@ -15,6 +15,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::BroadPhase: return "broad phase";
         case Stage::Sphere: return "sphere";
         case Stage::Cube: return "cube";
+        case Stage::Cylinder: return "cylinder";
         case Stage::Ground: return "ground";
         case Stage::StrainLimit: return "strain limit";
         case Stage::SpeedLimit: return "speed limit";
@@ -29,7 +30,7 @@ void StepProfile::add(const StepProfile& other) {
         ms[i] += other.ms[i];
         runs[i] += other.runs[i];
     }
-    for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t i = 0; i < kColliderCount; ++i) {
         blocks_tested[i] += other.blocks_tested[i];
         blocks_offered[i] += other.blocks_offered[i];
     }
@@ -57,12 +58,13 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     }
     plan.wind = wind_active(settings.forces);
     const ColliderSettings& c = settings.colliders;
-    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.ground.enabled;
+    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.cylinder.enabled || c.ground.enabled;
     if (c.contact == ContactModel::Penalty) {
         plan.contact = any_enabled && c.thickness > 0.0f;  // no shell, no force (penalty_contact.hpp)
     } else {
         plan.sphere = c.sphere.enabled;
         plan.cube = c.cube.enabled;
+        plan.cylinder = c.cylinder.enabled;
         plan.ground = c.ground.enabled;
     }
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
@@ -122,11 +124,11 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     }
     const ColliderSettings& c = settings.colliders;
     const bool penalty = c.contact == ContactModel::Penalty;
-    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.ground.enabled;
+    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.cylinder.enabled || c.ground.enabled;
     if (plan.contact) {
         std::string which;
         for (const auto& [on, name] : {std::pair{c.sphere.enabled, "sphere"}, std::pair{c.cube.enabled, "cube"},
-                                       std::pair{c.ground.enabled, "ground"}}) {
+                                       std::pair{c.cylinder.enabled, "cylinder"}, std::pair{c.ground.enabled, "ground"}}) {
             if (on) which.append(which.empty() ? "" : ", ").append(name);
         }
         out.push_back({Stage::Contact, velocity ? Fused : Runs,
@@ -154,6 +156,7 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     };
     collider(Stage::Sphere, plan.sphere, c.sphere.enabled, "colliders.sphere.enabled is false");
     collider(Stage::Cube, plan.cube, c.cube.enabled, "colliders.cube.enabled is false");
+    collider(Stage::Cylinder, plan.cylinder, c.cylinder.enabled, "colliders.cylinder.enabled is false");
     collider(Stage::Ground, plan.ground, c.ground.enabled, "colliders.ground.enabled is false");
     out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
     out.push_back({Stage::SpeedLimit, when(plan.speed_limit, Skipped), plan.speed_limit ? "" : "forces.max_speed is 0"});

@@ -50,6 +50,52 @@ MeshData make_cube() {
     return m;
 }
 
+MeshData make_cylinder(int slices) {
+    MeshData m;
+    const float pi = std::numbers::pi_v<float>;
+    // phi runs from +x toward -z, as the sphere's longitudes do: with the top ring first, (a, b, a + 1) is
+    // counter-clockwise seen from outside.
+    auto ring = [&](int j) {
+        const float phi = 2.0f * pi * static_cast<float>(j) / static_cast<float>(slices);
+        return glm::vec3(std::cos(phi), 0.0f, -std::sin(phi));
+    };
+    // Side: a top and a bottom vertex per slice edge (the seam is doubled for the UVs).
+    for (int j = 0; j <= slices; ++j) {
+        const glm::vec3 n = ring(j);
+        const float u = static_cast<float>(j) / static_cast<float>(slices);
+        for (float y : {0.5f, -0.5f}) {
+            m.positions.push_back(n + glm::vec3(0.0f, y, 0.0f));
+            m.normals.push_back(n);
+            m.uvs.emplace_back(u, y + 0.5f);
+        }
+    }
+    for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(slices); ++j) {
+        const std::uint32_t a = 2 * j, b = a + 1;  // top and bottom of edge j; edge j + 1's are a + 2, b + 2
+        m.indices.insert(m.indices.end(), {a, b, a + 2, a + 2, b, b + 2});
+    }
+    // Caps: a centre and a ring each, facing +y (top) and -y (bottom).
+    for (float y : {0.5f, -0.5f}) {
+        const glm::vec3 normal(0.0f, y > 0.0f ? 1.0f : -1.0f, 0.0f);
+        const auto centre = static_cast<std::uint32_t>(m.positions.size());
+        m.positions.emplace_back(0.0f, y, 0.0f);
+        m.normals.push_back(normal);
+        m.uvs.emplace_back(0.5f, 0.5f);
+        for (int j = 0; j < slices; ++j) {
+            const glm::vec3 n = ring(j);
+            m.positions.push_back(n + glm::vec3(0.0f, y, 0.0f));
+            m.normals.push_back(normal);
+            m.uvs.emplace_back(0.5f + 0.5f * n.x, 0.5f - 0.5f * n.z);
+        }
+        for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(slices); ++j) {
+            const std::uint32_t k = centre + 1 + j, next = centre + 1 + (j + 1) % static_cast<std::uint32_t>(slices);
+            // Counter-clockwise seen from above for the top, from below for the bottom.
+            if (y > 0.0f) m.indices.insert(m.indices.end(), {centre, k, next});
+            else m.indices.insert(m.indices.end(), {centre, next, k});
+        }
+    }
+    return m;
+}
+
 MeshData make_ground(float half_size) {
     MeshData m;
     const glm::vec2 corners[4] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};

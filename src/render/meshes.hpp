@@ -1,4 +1,4 @@
-// Geometry of the static shapes (sphere, cube, ground), built on the CPU and uploaded once.
+// Geometry of the static shapes (sphere, cube, cylinder, ground), built on the CPU and uploaded once.
 #pragma once
 
 #include <glm/vec2.hpp>
@@ -20,6 +20,10 @@ struct MeshData {
 MeshData make_uv_sphere(int stacks, int slices);
 // Unit cube (edge 1, centred on the origin), 4 vertices per face so each face has its own normal and UVs.
 MeshData make_cube();
+// Closed unit cylinder (radius 1, height 1, axis along y, centred on the origin) of `slices` side quads: the
+// side with radial normals and two flat caps with their own vertices and normals (+y on top, -y below), so
+// the rim is a sharp edge. Scaled by (radius, height, radius) it is the cylinder collider.
+MeshData make_cylinder(int slices);
 // A square in the y = 0 plane, `half_size` metres from the centre to each edge, facing +y.
 MeshData make_ground(float half_size);
 

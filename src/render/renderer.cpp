@@ -62,6 +62,12 @@ glm::vec4 kind_color(SpringKind kind) {
     return glm::vec4(1.0f);
 }
 
+// The unit cylinder mesh (meshes.hpp) placed and sized as the collider.
+glm::mat4 cylinder_model(const CylinderCollider& cylinder) {
+    return glm::scale(glm::translate(glm::mat4(1.0f), cylinder.center),
+                      glm::vec3(cylinder.radius, cylinder.height, cylinder.radius));
+}
+
 }  // namespace
 
 GpuMesh::GpuMesh(const MeshData& data, bool dynamic) : index_count_(static_cast<GLsizei>(data.indices.size())) {
@@ -97,6 +103,7 @@ Renderer::Renderer(const std::filesystem::path& shader_dir, const std::filesyste
       crate_(load_texture(texture_dir / "crate.png")),
       sphere_(make_uv_sphere(32, 64)),
       cube_(make_cube()),
+      cylinder_(make_cylinder(96)),
       ground_(make_ground(50.0f)) {
     glBindTexture(GL_TEXTURE_2D, shadow_depth_.get());
     glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, shadow_size_, shadow_size_, 0, GL_DEPTH_COMPONENT, GL_FLOAT,
@@ -223,6 +230,10 @@ void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_
         shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
         cube_.draw();
     }
+    if (c.cylinder.enabled) {
+        shadow_.set("u_model", cylinder_model(c.cylinder));
+        cylinder_.draw();
+    }
 }
 
 void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projection,
@@ -273,6 +284,11 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
         material(glm::vec4(1.0f), &crate_, glm::vec2(1.0f), 0.35f, 32.0f);
         lit_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
         cube_.draw();
+    }
+    if (c.cylinder.enabled) {
+        material({0.30f, 0.62f, 0.38f, 1.0f}, nullptr, glm::vec2(1.0f), 0.45f, 40.0f);
+        lit_.set("u_model", cylinder_model(c.cylinder));
+        cylinder_.draw();
     }
     if (!input.view.wireframe && !input.sim.topology().triangles.empty()) {
         material(input.view.texture ? glm::vec4(1.0f) : glm::vec4(0.80f, 0.36f, 0.26f, 1.0f),

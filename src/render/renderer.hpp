@@ -98,6 +98,7 @@ private:
 
     GpuMesh sphere_;
     GpuMesh cube_;
+    GpuMesh cylinder_;
     GpuMesh ground_;
     // The cloth as drawn: the CPU copy (positions_, normals_) and the GPU mesh made from that copy. Only
     // sync_cloth writes them, all together, so the copy, the mesh and the stamp always describe one cloth.

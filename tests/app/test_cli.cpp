@@ -163,8 +163,8 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 12);
-    // drape-sphere: fast solver, sphere and ground, no wind, no cube, no limits.
+    CHECK(stage.size() == 13);
+    // drape-sphere: fast solver, sphere and ground, no wind, no cube, no cylinder, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 38);
     CHECK(stage.at("fast solver").at("ms").get<double>() > 0.0);
@@ -173,7 +173,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(stage.at("sphere").at("blocks_offered") == 30 * 38 * 120);  // 40 rows of 3 blocks
     CHECK(stage.at("sphere").at("blocks_tested").get<long long>() <= 30 * 38 * 120);
     CHECK(stage.at("ground").at("blocks_tested") == 0);  // the cloth is far above the ground
-    for (const char* skipped : {"wind", "contact", "cube", "strain limit", "speed limit"}) {
+    for (const char* skipped : {"wind", "contact", "cube", "cylinder", "strain limit", "speed limit"}) {
         INFO(skipped);
         CHECK(stage.at(skipped).at("state") == "skipped");
         CHECK(stage.at(skipped).at("ms") == 0.0);
@@ -182,6 +182,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     }
     CHECK_THAT(stage.at("wind").at("note").get<std::string>(), Contains("forces.wind"));
     CHECK_THAT(stage.at("cube").at("note").get<std::string>(), Contains("colliders.cube.enabled"));
+    CHECK_THAT(stage.at("cylinder").at("note").get<std::string>(), Contains("colliders.cylinder.enabled"));
     CHECK_THAT(stage.at("contact").at("note").get<std::string>(), Contains("colliders.contact is projection"));
     double sum = 0.0;
     for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
@@ -202,6 +203,23 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
         CHECK(with.at(projection).at("state") == "skipped");
         CHECK_THAT(with.at(projection).at("note").get<std::string>(), Contains("colliders.contact is penalty"));
     }
+
+    // The cylinder in the sphere's place: its stage runs and reports its broad phase, the sphere's is skipped.
+    const RunResult cylinder = run_clothsim(
+        {"--headless", "--scene", "drape-sphere", "--steps", "30", "--set", "colliders.sphere.enabled=false", "--set",
+         "colliders.cylinder.enabled=true", "--set", "colliders.cylinder.center=[0, 0.425, 0]", "--set",
+         "colliders.cylinder.radius=0.3", "--set", "colliders.cylinder.height=0.85", "--json"});
+    CAPTURE_RUN(cylinder);
+    REQUIRE(cylinder.code == 0);
+    const nlohmann::json cylinder_profile = nlohmann::json::parse(cylinder.out).at("profile");
+    std::map<std::string, nlohmann::json> on;
+    for (const auto& s : cylinder_profile.at("stages")) on[s.at("stage").get<std::string>()] = s;
+    CHECK(on.at("cylinder").at("state") == "runs");
+    CHECK(on.at("cylinder").at("substeps_run") == 30 * 38);
+    CHECK(on.at("cylinder").at("blocks_offered") == 30 * 38 * 120);
+    CHECK(on.at("cylinder").at("blocks_tested").get<long long>() > 0);  // the cloth lands on it in 0.17 s
+    CHECK(on.at("cylinder").at("blocks_tested").get<long long>() < 30 * 38 * 120);
+    CHECK(on.at("sphere").at("state") == "skipped");
 }
 
 TEST_CASE("cli: a headless run reports when the cloth slept, and bending 0 as a skipped spring kind") {

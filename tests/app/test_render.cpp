@@ -5,6 +5,7 @@
 //   cloth (fabric.png, lit or shadowed, both sides)  red-dominant: (228, 124, 105), (198, 94, 72), back (103, 48, 34)
 //   sphere (0.25, 0.45, 0.85) lit or shadowed         blue-dominant, e.g. (84, 110, 149): B - R about 65
 //   crate (crate.png)                                 blue-grey, e.g. (85, 95, 116), (128, 141, 166)
+//   cylinder (0.30, 0.62, 0.38) lit or shadowed       green-dominant: (138, 185, 150) lit, (87, 120, 100) shadowed
 //   ground                                            light grey (215, 219, 214); its shadows (125, 131, 135)
 //   sky (clear colour, sRGB-encoded)                  (173, 182, 194)
 //   panel (ImGui dark style, 92% opaque)              background (28, 28, 29), frames (35, 53, 79), white text
@@ -69,6 +70,8 @@ bool is_cloth(Rgb c) { return c.r > c.g + 30 && c.r > c.b + 30; }
 bool is_blue(Rgb c) { return c.b > c.r + 30; }
 // The crate's blue-grey. The sky matches it too, so it is only looked for below the horizon, near the cube.
 bool is_crate(Rgb c) { return c.b > c.r + 15 && c.b > c.g + 8; }
+// The cylinder's green, lit or shadowed (nothing else in the scene is green-dominant).
+bool is_green(Rgb c) { return c.g > c.r + 20 && c.g > c.b + 12; }
 // The ImGui dark window background (28, 28, 29), give or take what shows through its 8% transparency.
 bool is_panel_background(Rgb c) {
     return std::max({c.r, c.g, c.b}) <= 40 && std::max({c.r, c.g, c.b}) - std::min({c.r, c.g, c.b}) <= 6;
@@ -196,6 +199,23 @@ Rect cube_on_screen(const clothsim::Scene& scene) {
         const glm::vec3 s = to_screen(camera, cube.center + sign * cube.size);
         box = {std::min(box.x0, int(s.x)), std::min(box.y0, int(s.y)), std::max(box.x1, int(s.x) + 1),
                std::max(box.y1, int(s.y) + 1)};
+    }
+    return clip_to_view(box);
+}
+
+// The screen box of the cylinder's two rims in the app's start camera, clipped to the view.
+Rect cylinder_on_screen(const clothsim::Scene& scene) {
+    const clothsim::OrbitCamera camera = start_camera(clothsim::build_simulation(scene));
+    const clothsim::CylinderCollider& c = scene.settings.colliders.cylinder;
+    Rect box{kWidth, kHeight, 0, 0};
+    for (int k = 0; k < 128; ++k) {
+        const float phi = 6.2831853f * static_cast<float>(k) / 128.0f;
+        for (float y : {-0.5f, 0.5f}) {
+            const glm::vec3 s =
+                to_screen(camera, c.center + glm::vec3(c.radius * std::cos(phi), y * c.height, c.radius * std::sin(phi)));
+            box = {std::min(box.x0, int(s.x)), std::min(box.y0, int(s.y)), std::max(box.x1, int(s.x) + 1),
+                   std::max(box.y1, int(s.y) + 1)};
+        }
     }
     return clip_to_view(box);
 }
@@ -532,4 +552,43 @@ TEST_CASE("render a run whose first step the guard rejects: the last good state,
         CHECK(r.code == 0);
         CHECK(load_png(png).width == kWidth);
     }
+}
+
+TEST_CASE("render the cylinder where it is, and no cylinder when it is disabled") {
+    // No bundled scene has a cylinder yet: drape-sphere with one in the sphere's place (its top face where the
+    // sphere's top is). After one frame the cloth is still flat above it.
+    const std::vector<std::string> no_sphere = {"--set", "colliders.sphere.enabled=false"};
+    std::vector<std::string> with_cylinder = no_sphere;
+    clothsim::Scene scene = clothsim::load_scene("drape-sphere");
+    clothsim::apply_override(scene, no_sphere[1]);
+    for (const char* field : {"colliders.cylinder.center=[0, 0.425, 0]", "colliders.cylinder.radius=0.3",
+                              "colliders.cylinder.height=0.85"}) {
+        with_cylinder.insert(with_cylinder.end(), {"--set", field});
+        clothsim::apply_override(scene, field);
+    }
+    const clothsim::Scene scene_without = scene;  // the same cylinder, disabled: the camera frames the cloth alone
+    clothsim::apply_override(scene, "colliders.cylinder.enabled=true");
+    with_cylinder.insert(with_cylinder.end(), {"--set", "colliders.cylinder.enabled=true"});
+    const Rect box = cylinder_on_screen(scene), box_without = cylinder_on_screen(scene_without);
+    REQUIRE(box.area() > 20000);  // px: measured 72,000
+    REQUIRE(box_without.area() > 20000);
+    // The box twice as wide and high around it, less the cylinder's box: ground, shadow, cloth; no green.
+    const int w = box.x1 - box.x0, h = box.y1 - box.y0;
+    const Rect around = clip_to_view({box.x0 - w / 2, box.y0 - h / 2, box.x1 + w / 2, box.y1 + h / 2});
+
+    const Screenshot& with = screenshot("drape-sphere", 1, with_cylinder);
+    const Screenshot& without = screenshot("drape-sphere", 1, no_sphere);
+    REQUIRE(usable(with));
+    REQUIRE(usable(without));
+    const long long in_box = count(with.image, box, is_green);
+    const long long around_box = count(with.image, around, is_green) - in_box;
+    const long long in_box_without = count(without.image, box_without, is_green);
+    INFO("cylinder box x [" << box.x0 << ", " << box.x1 << "), y [" << box.y0 << ", " << box.y1 << "): " << in_box
+                            << " of " << box.area() << " green, " << around_box << " around it; disabled: "
+                            << in_box_without << " of " << box_without.area());
+    // A cylinder seen from above its top fills its screen box but for the corners beside its elliptic rims.
+    // Measured: 90% of the box green (lit, and in the cloth's shadow), none around it, none when disabled.
+    CHECK(in_box > 0.8 * static_cast<double>(box.area()));
+    CHECK(around_box < 0.01 * static_cast<double>(around.area()));
+    CHECK(in_box_without < 0.01 * static_cast<double>(box_without.area()));
 }

@@ -151,6 +151,7 @@ TEST_CASE("broad_phase particle_bounds is the box of the finite coordinates of i
     REQUIRE(none.empty());
     CHECK_FALSE(may_touch(SphereCollider{true, glm::vec3(0.0f), 1e6f, 0.0f}, 1.0f, none));
     CHECK_FALSE(may_touch(CubeCollider{true, glm::vec3(0.0f), glm::vec3(1e6f), 0.0f}, 1.0f, none));
+    CHECK_FALSE(may_touch(CylinderCollider{true, glm::vec3(0.0f), 1e6f, 1e6f, 0.0f}, 1.0f, none));
     CHECK_FALSE(may_touch(GroundCollider{true, 1e6f, 0.0f}, 1.0f, none));
 }
 
@@ -204,11 +205,13 @@ TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the
           "[broad_phase]") {
     const SphereCollider sphere{true, {0.0f, 0.5f, 0.0f}, 0.3f, 0.3f};
     const CubeCollider cube{true, {1.0f, 0.4f, -2.0f}, {0.5f, 0.2f, 0.8f}, 0.3f};
+    const CylinderCollider cylinder{true, {-1.0f, 0.3f, 1.0f}, 0.09f, 0.6f, 0.3f};
     const GroundCollider ground{true, -0.25f, 0.5f};
     const float t = 0.005f;
     const Box far{{10.0f, 10.0f, 10.0f}, {11.0f, 12.0f, 13.0f}};
     CHECK_FALSE(may_touch(sphere, t, far));
     CHECK_FALSE(may_touch(cube, t, far));
+    CHECK_FALSE(may_touch(cylinder, t, far));
     CHECK_FALSE(may_touch(ground, t, far));
     CHECK(may_touch(sphere, t, Box{sphere.center - 0.01f, sphere.center + 0.01f}));
     CHECK(may_touch(sphere, t, Box{sphere.center, sphere.center}));
@@ -221,6 +224,17 @@ TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the
     CHECK_FALSE(may_touch(ground, t, Box{{0.0f, ground.height + t + 0.01f, 0.0f}, {1.0f, 5.0f, 1.0f}}));
     const float right = cube.center.x + 0.5f * cube.size.x + t + 0.01f;
     CHECK_FALSE(may_touch(cube, t, Box{{right, 0.0f, -2.0f}, {right + 1.0f, 1.0f, -1.0f}}));
+    // The cylinder: a box holding its centre, one on its axis above it, above the top face's reach and beside
+    // the side's reach; a box in the corner of its bounding box, beyond the round side, is rejected too.
+    CHECK(may_touch(cylinder, t, Box{cylinder.center, cylinder.center}));
+    const float top = cylinder.center.y + 0.5f * cylinder.height;
+    CHECK(may_touch(cylinder, t, Box{{-1.0f, top + t - 0.001f, 1.0f}, {-1.0f, top + 1.0f, 1.0f}}));
+    CHECK_FALSE(may_touch(cylinder, t, Box{{-1.0f, top + t + 0.01f, 1.0f}, {-1.0f, top + 1.0f, 1.0f}}));
+    const float beside = cylinder.center.x + cylinder.radius + t + 0.01f;
+    CHECK_FALSE(may_touch(cylinder, t, Box{{beside, 0.0f, 0.5f}, {beside + 1.0f, 0.5f, 1.5f}}));
+    const float corner = cylinder.radius * 0.8f;  // (0.8, 0.8) R from the axis: 1.13 R, beyond R + t
+    const glm::vec3 c(cylinder.center.x + corner, cylinder.center.y, cylinder.center.z + corner);
+    CHECK_FALSE(may_touch(cylinder, t, Box{c, c + 0.1f}));
 }
 
 TEST_CASE("broad_phase may_touch never rejects a particle the sphere would move", "[broad_phase]") {
@@ -257,6 +271,34 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cube would move", 
     check_coverage(tally);
 }
 
+TEST_CASE("broad_phase may_touch never rejects a particle the cylinder would move", "[broad_phase]") {
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> size(0.01f, 2.0f), thickness(0.0f, 0.02f), unit(-1.0f, 1.0f);
+    std::uniform_real_distribution<float> angle(0.0f, 6.2831853f);
+    Tally tally;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const CylinderCollider cylinder{true, random_vec(rng, pick_scale(rng)), size(rng), size(rng), 0.4f};
+        const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
+        const float reach_r = cylinder.radius + t, reach_y = 0.5f * cylinder.height + t;
+        // A point near the side, near a face, or (one time in three) near a rim: at the reach plus an offset.
+        const float a = angle(rng);
+        float r = std::abs(unit(rng)) * reach_r, y = unit(rng) * reach_y;
+        const int kind = trial % 3;
+        if (kind != 1) r = reach_r + offset(rng);
+        if (kind != 0) y = (unit(rng) < 0.0f ? -1.0f : 1.0f) * (reach_y + offset(rng));
+        if (kind == 2 && r > cylinder.radius && std::abs(y) > 0.5f * cylinder.height) {
+            // Beyond the rim the shell is round: probe around the rim's circle at radius t + offset.
+            const float b = std::uniform_real_distribution<float>(0.0f, 1.5707963f)(rng);
+            const float d = std::max(t + offset(rng), 0.0f);
+            r = cylinder.radius + d * std::cos(b);
+            y = (y < 0.0f ? -1.0f : 1.0f) * (0.5f * cylinder.height + d * std::sin(b));
+        }
+        const glm::vec3 p = cylinder.center + glm::vec3(r * std::cos(a), y, r * std::sin(a));
+        check_conservative(cylinder, t, p, rng, tally);
+    }
+    check_coverage(tally);
+}
+
 TEST_CASE("broad_phase may_touch never rejects a particle the ground would move", "[broad_phase]") {
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> thickness(0.0f, 0.02f);
@@ -276,6 +318,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
     ColliderSettings colliders;
     colliders.sphere = {true, {0.0f, 0.3f, 0.0f}, 0.3f, 0.4f};  // resting on the ground
     colliders.cube = {true, {0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}, 0.3f};
+    colliders.cylinder = {true, {-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f, 0.3f};  // on the ground too
     colliders.ground = {true, 0.0f, 0.5f};
     colliders.thickness = 0.005f;
 
@@ -289,8 +332,9 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         collide_stage(st, colliders, true, blocks, &profile);
         INFO("particle at (" << st.position.x[0] << ", " << st.position.y[0] << ", " << st.position.z[0] << ")");
         CHECK(st.position.y[0] >= colliders.ground.height + colliders.thickness);
-        CHECK(profile.blocks_tested[2] == 1);  // the far particle's block is culled
-        CHECK(profile.blocks_offered[2] == 2);
+        const int ground = collider_index(Stage::Ground);
+        CHECK(profile.blocks_tested[ground] == 1);  // the far particle's block is culled
+        CHECK(profile.blocks_offered[ground] == 2);
     }
 
     std::mt19937 rng(5);
@@ -329,7 +373,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         CHECK(sorted.position == all.position);
         CHECK(sorted.motion == all.motion);
         CHECK(!(sorted.position == culled.position));  // something was pushed
-        for (std::size_t c = 0; c < 3; ++c) {
+        for (std::size_t c = 0; c < kColliderCount; ++c) {
             INFO("collider " << c << ": " << profile.blocks_tested[c] << " of " << profile.blocks_offered[c]);
             CHECK(profile.blocks_tested[c] > 0);
             if (size <= kBlockParticles) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);

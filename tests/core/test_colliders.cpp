@@ -1,4 +1,5 @@
-// Colliders: no free particle ends a step inside the sphere, the box or below the ground; Coulomb friction.
+// Colliders: no free particle ends a step inside the sphere, the box, the cylinder or below the ground; the
+// shortest way out (the cylinder's faces, side and rims); continuous collision; Coulomb friction.
 #include "support.hpp"
 
 #include "clothsim/colliders.hpp"
@@ -41,6 +42,33 @@ MassSpring slider(float friction, float speed) {
     s.settings.integration.dt = 1.0f / 60.0f;
     s.settings.integration.substeps = 20;
     return build_simulation(s);
+}
+
+// The Cusick drape tester's support (ISO 9073-9, BS 5058: an 18 cm disc), here a solid cylinder 0.3 m tall
+// standing on y = 0.1; its top face is at y = 0.4.
+CylinderCollider support(float friction) {
+    return {true, {0.1f, 0.25f, -0.2f}, 0.09f, 0.3f, friction};
+}
+
+// One free particle at `start` moving at `velocity`, with gravity, no ground, `substeps` per 1/60 s step.
+Scene lone_particle(glm::vec3 start, glm::vec3 velocity, int substeps) {
+    Scene s = test::chain(1, 1.0f, 0.1f, 0.0f);
+    s.settings.forces.gravity = {0.0f, -9.81f, 0.0f};
+    s.settings.colliders.thickness = 0.005f;
+    s.cloth.origin = start;
+    s.cloth.velocity = velocity;
+    s.settings.integration.dt = 1.0f / 60.0f;
+    s.settings.integration.substeps = substeps;
+    s.settings.solver.sleep_speed = 0.0f;
+    return s;
+}
+
+// drape-sphere with a cylinder where the sphere was, its top face where the sphere's top is.
+Scene drape_on_cylinder() {
+    Scene s = load_scene("drape-sphere");
+    s.settings.colliders.sphere.enabled = false;
+    s.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
+    return s;
 }
 
 }  // namespace
@@ -191,5 +219,241 @@ TEST_CASE("colliders implicit Euler and XPBD at dt 0.1 with 1 substep drape the 
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
             CHECK(signed_distance(sphere, sim.position(i)) > -1e-3f);
         }
+    }
+}
+
+TEST_CASE("colliders a particle dropped on the cylinder's top face rests at top + thickness", "[colliders]") {
+    const CylinderCollider cylinder = support(0.3f);
+    const double top = double(cylinder.center.y) + 0.5 * double(cylinder.height);
+    const double thickness = 0.005;
+    for (const char* integrator : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd"}) {
+        INFO(integrator);
+        // Off the axis, dropped from 0.2 m above the top: it lands at 2 m/s after 0.2 s.
+        Scene s = lone_particle({0.13f, 0.6f, -0.17f}, glm::vec3(0.0f), 20);
+        s.settings.colliders.cylinder = cylinder;
+        apply_override(s, std::string("integration.integrator=") + integrator);
+        MassSpring sim = build_simulation(s);
+        double lowest = INFINITY;
+        for (int step = 0; step < 60; ++step) {  // 1 s: falls, lands, rests
+            sim.run_steps(1);
+            lowest = std::min(lowest, double(signed_distance(cylinder, sim.position(0))));
+        }
+        const glm::dvec3 p = sim.state().position.get(0);
+        INFO("rests at (" << p.x << ", " << p.y << ", " << p.z << "); top + thickness = " << top + thickness);
+        CHECK(p.y == Approx(top + thickness).margin(1e-6));
+        CHECK(p.x == Approx(0.13).margin(1e-6));  // straight down: no sideways push on the face
+        CHECK(p.z == Approx(-0.17).margin(1e-6));
+        // At rest: the contact removes each substep's fall (the motion). (Verlet's reported velocity adds
+        // g h / 2 to it, its second-order estimate, so the motion is what says "at rest".)
+        CHECK(glm::length(sim.state().motion.get(0)) < 1e-9);
+        CHECK(lowest >= 0.0);  // never inside, landing included
+    }
+}
+
+TEST_CASE("colliders the cylinder pushes particles out along the shortest way: faces, side, rims",
+          "[colliders]") {
+    // Radius 0.5, height 1 around the origin: the top face at y = 0.5, the side at r = 0.5.
+    const CylinderCollider cylinder{true, {0.0f, 0.0f, 0.0f}, 0.5f, 1.0f, 0.0f};
+    const float t = 0.01f;
+    const glm::vec3 dir(std::cos(1.0f), 0.0f, -std::sin(1.0f));  // an arbitrary direction around the axis
+    State st = test::free_particles({{0.1f, 0.45f, 0.2f},      // inside, nearest the top face
+                                     {0.0f, -0.47f, 0.0f},     // inside, nearest the bottom face
+                                     0.46f * dir,              // inside at mid height: leaves radially
+                                     0.505f * dir,             // outside, in the side's shell
+                                     0.3f * dir + glm::vec3(0.0f, 0.2f, 0.0f),  // pinned, inside
+                                     {0.0f, 0.0f, 0.0f}},      // on the axis, at the centre: out of a face
+                                    0.01f);
+    st.pinned[4] = 1;
+    collide(st, cylinder, t);
+    CHECK(st.position.get(0).y == Approx(0.51));
+    CHECK(st.position.get(0).x == Approx(0.1f));
+    CHECK(st.position.get(0).z == Approx(0.2f));
+    CHECK(st.position.get(1).y == Approx(-0.51));
+    const glm::dvec3 radial = st.position.get(2);
+    CHECK(radial.y == 0.0);
+    CHECK(glm::length(glm::dvec2(radial.x, radial.z)) == Approx(0.51));
+    CHECK(glm::dot(glm::normalize(radial), glm::dvec3(dir)) == Approx(1.0));  // straight out from the axis
+    CHECK(glm::length(st.position.get(3)) == Approx(0.51));
+    CHECK(st.position.get(4) == glm::dvec3(0.3f * dir + glm::vec3(0.0f, 0.2f, 0.0f)));  // pinned: never moved
+    CHECK(std::abs(st.position.get(5).y) == Approx(0.51));  // a face is nearer than the side (0.5 vs 0.5 + t)
+    for (std::size_t i : {0u, 1u, 2u, 3u, 5u}) {
+        INFO("particle " << i);
+        CHECK(signed_distance(cylinder, st.position.get(i)) == Approx(t).margin(1e-6));
+        CHECK(st.motion.get(i) == glm::dvec3(0.0));  // the push gives no velocity
+    }
+
+    // At a rim the nearest point of the solid is on the rim's circle. Inside, just below the top and just
+    // inside the side, the particle leaves through the nearer of the two: straight up, or straight out.
+    State rim = test::free_particles({{0.45f, 0.48f, 0.0f}, {0.48f, 0.45f, 0.0f}, {0.503f, 0.504f, 0.0f},
+                                      0.503f * dir + glm::vec3(0.0f, -0.504f, 0.0f)},
+                                     0.01f);
+    collide(rim, cylinder, t);
+    CHECK(rim.position.get(0).y == Approx(0.51));  // 0.02 below the top, 0.05 inside the side: up
+    CHECK(rim.position.get(0).x == Approx(0.45f));
+    CHECK(rim.position.get(1).x == Approx(0.51));  // 0.05 below the top, 0.02 inside the side: out
+    CHECK(rim.position.get(1).y == Approx(0.45f));
+    // Outside, diagonally off the top rim (0.003 out, 0.004 up: 0.005 from the rim): pushed along that
+    // diagonal to t from the rim, not straight up (the face's plane) nor straight out (the side's).
+    CHECK(rim.position.get(2).x == Approx(0.5 + 0.6 * t));
+    CHECK(rim.position.get(2).y == Approx(0.5 + 0.8 * t));
+    CHECK(rim.position.get(2).z == 0.0);
+    // The same off the bottom rim, around the axis.
+    const glm::dvec3 bottom = rim.position.get(3);
+    CHECK(glm::length(glm::dvec2(bottom.x, bottom.z)) == Approx(0.5 + 0.6 * t));
+    CHECK(bottom.y == Approx(-0.5 - 0.8 * t));
+    for (std::size_t i = 0; i < 4; ++i) {
+        INFO("rim particle " << i);
+        CHECK(signed_distance(cylinder, rim.position.get(i)) == Approx(t).margin(1e-6));
+    }
+
+    // Signed distances: inside (the nearer of face and side), beside the side, above a face, off a rim.
+    CHECK(signed_distance(cylinder, {0.0f, 0.0f, 0.0f}) == Approx(-0.5f));
+    CHECK(signed_distance(cylinder, {0.1f, 0.3f, 0.0f}) == Approx(-0.2f));
+    CHECK(signed_distance(cylinder, {0.0f, 0.0f, 2.0f}) == Approx(1.5f));
+    CHECK(signed_distance(cylinder, {0.3f, -1.5f, 0.0f}) == Approx(1.0f));
+    CHECK(signed_distance(cylinder, {0.8f, 0.9f, 0.0f}) == Approx(0.5f));  // (0.3, 0.4) from the rim
+}
+
+TEST_CASE("colliders the cylinder removes inward motion and keeps the rest when frictionless", "[colliders]") {
+    const CylinderCollider cylinder{true, {0.0f, 0.0f, 0.0f}, 0.5f, 1.0f, 0.0f};
+    State st = test::free_particles({{0.1f, 0.505f, 0.0f}, {0.0f, 0.0f, 0.505f}}, 0.01f);
+    st.motion.set(0, {0.02f, -0.01f, 0.0f});  // sliding over the top face and into it
+    st.motion.set(1, {0.01f, 0.0f, -0.004f});  // sliding around the side and into it
+    collide(st, cylinder, 0.01f);
+    CHECK(st.motion.get(0).x == Approx(0.02f));
+    CHECK(st.motion.get(0).y == 0.0);
+    CHECK(st.motion.get(1).x == Approx(0.01f));
+    CHECK(st.motion.get(1).z == 0.0);
+    st.position.set(0, {0.1f, 0.505f, 0.0f});
+    st.motion.set(0, {0.0f, 0.03f, 0.0f});  // already leaving: keeps its outward motion
+    collide(st, cylinder, 0.01f);
+    CHECK(st.motion.get(0).y == Approx(0.03f));
+}
+
+TEST_CASE("colliders a particle too fast for one substep does not pass through the cylinder", "[colliders]") {
+    // Straight paths of 2 m in one substep through the middle of a cylinder of radius 0.3 around the origin:
+    // across a tall one (height 1) through the side, down a flat one (height 0.4) through the top face. Each
+    // is shaped so that 0.05 m past the centre the nearest way out is through the far side of the path.
+    const CylinderCollider tall{true, {0.0f, 0.0f, 0.0f}, 0.3f, 1.0f, 0.0f};
+    const CylinderCollider flat{true, {0.0f, 0.0f, 0.0f}, 0.3f, 0.4f, 0.0f};
+    const float thickness = 0.01f;
+    struct Path {
+        const char* what;
+        const CylinderCollider& cylinder;
+        glm::vec3 axis;  // unit direction of travel
+        float face;      // where the near surface is along it, from the centre
+    };
+    for (const Path& path : {Path{"through the side", tall, {1.0f, 0.0f, 0.0f}, 0.3f},
+                             Path{"through the side, around the axis", tall, glm::normalize(glm::vec3(1.0f, 0.0f, -2.0f)), 0.3f},
+                             Path{"down through the top face", flat, {0.0f, -1.0f, 0.0f}, 0.2f}}) {
+        // Ends 1 m past the centre (outside), and 0.05 m past it (inside, nearest way out the far side).
+        for (float end : {1.0f, 0.05f}) {
+            INFO(path.what << ", ends " << end << " m past the centre");
+            State st = test::free_particles({end * path.axis}, 0.01f);
+            st.motion.set(0, (end + 1.0f) * path.axis);  // came from 1 m before the centre
+            collide(st, path.cylinder, thickness);
+            const glm::dvec3 p = st.position.get(0);
+            CHECK(glm::dot(p, glm::dvec3(path.axis)) == Approx(-(path.face + thickness)).margin(1e-5));  // near side
+            CHECK(glm::length(p - glm::dot(p, glm::dvec3(path.axis)) * glm::dvec3(path.axis)) < 1e-6);  // on its path
+            CHECK(glm::length(st.motion.get(0)) == Approx(0.0).margin(1e-6));  // its (all inward) motion gone
+        }
+    }
+    const CylinderCollider& cylinder = flat;
+    // Across a rim: from above and beside the top rim, down and across to below the far side. It enters the
+    // shell through the top face's plane, beyond the side's: it stops there, its downward motion removed.
+    {
+        State st = test::free_particles({{-0.5f, -0.5f, 0.0f}}, 0.01f);
+        const glm::dvec3 start(0.35, 0.4, 0.0);
+        st.motion.set(0, st.position.get(0) - start);
+        collide(st, cylinder, thickness);
+        const glm::dvec3 p = st.position.get(0);
+        CHECK(signed_distance(cylinder, p) > 0.0f);
+        CHECK(p.y == Approx(0.2 + thickness).margin(1e-5));  // where the path met the top face's shell
+        CHECK(st.motion.get(0).y == Approx(0.0).margin(1e-9));
+        CHECK(st.motion.get(0).x < 0.0);  // the sideways part kept
+    }
+    // Starting beside the top rim, in the corner where the rounded shell leaves room (outside the shell but
+    // within thickness of both the face's and the side's planes), heading through the solid: stopped where it
+    // started, its motion toward the rim removed.
+    {
+        const glm::dvec3 start(0.3 + 0.9 * thickness, 0.2 + 0.9 * thickness, 0.0);
+        REQUIRE(signed_distance(cylinder, glm::vec3(start)) > thickness);
+        State st = test::free_particles({{-1.0f, 0.0f, 0.0f}}, 0.01f);
+        st.motion.set(0, st.position.get(0) - start);
+        collide(st, cylinder, thickness);
+        CHECK(glm::length(st.position.get(0) - start) < 1e-6);
+        // From the rim's circle (the float radius and half height) to the start: about (1, 1) / sqrt(2).
+        const glm::dvec3 rim_normal =
+            glm::normalize(start - glm::dvec3(double(cylinder.radius), 0.5 * double(cylinder.height), 0.0));
+        CHECK(glm::dot(st.motion.get(0), rim_normal) == Approx(0.0).margin(1e-9));
+    }
+    // A glancing path that stays in the thickness shell (a particle sliding over the top face) is not a pass.
+    State slide = test::free_particles({{0.01f, 0.2f + thickness, 0.0f}}, 0.01f);
+    slide.motion.set(0, {0.02f, 0.0f, 0.0f});
+    collide(slide, cylinder, thickness);
+    CHECK(slide.position.get(0).x == Approx(0.01f));
+    CHECK(slide.motion.get(0).x == Approx(0.02f));
+}
+
+TEST_CASE("colliders friction on the cylinder's top face slows sliding at mu g and stops it at v^2 / (2 mu g)",
+          "[colliders]") {
+    // A wide disc (radius 0.5) so the particle stops on it: at most 0.255 m from x = -0.4 at 1 m/s.
+    const float v0 = 1.0f;
+    auto sliding = [&](float mu) {
+        const CylinderCollider cylinder{true, {0.0f, 0.1f, 0.0f}, 0.5f, 0.2f, mu};
+        Scene s = lone_particle({-0.4f, 0.2f + 0.005f, 0.0f}, {v0, 0.0f, 0.0f}, 20);
+        s.settings.colliders.cylinder = cylinder;
+        return build_simulation(s);
+    };
+    {
+        MassSpring sim = sliding(0.0f);
+        sim.run_steps(30);  // 0.5 s
+        CHECK(sim.position(0).x == Approx(-0.4f + 0.5f * v0).epsilon(1e-4));
+        CHECK(sim.velocities()[0].x == Approx(v0).epsilon(1e-4));
+        CHECK(sim.position(0).y == Approx(0.205f).margin(1e-6));
+    }
+    for (float mu : {0.2f, 0.5f, 1.0f}) {
+        MassSpring sim = sliding(mu);
+        const double stop_time = v0 / (mu * 9.81);
+        sim.run_steps(static_cast<long long>(std::ceil(0.5 * stop_time * 60)));
+        CHECK(sim.velocities()[0].x == Approx(v0 - mu * 9.81 * sim.time()).epsilon(0.02));
+        sim.run_steps(static_cast<long long>(std::ceil(stop_time * 60)));
+        const double distance = v0 * v0 / (2.0 * mu * 9.81);
+        INFO("mu " << mu << ": stopped after " << sim.position(0).x + 0.4 << " m, expected " << distance);
+        CHECK(sim.position(0).x + 0.4 == Approx(distance).epsilon(0.005));
+        CHECK(std::fabs(sim.velocities()[0].x) < 1e-3);
+        CHECK(sim.position(0).y == Approx(0.205f).margin(1e-6));  // still on the face
+    }
+}
+
+TEST_CASE("colliders a cloth drapes over the cylinder: none inside, on the top face and down the side",
+          "[colliders]") {
+    for (const char* integrator : {"verlet", "implicit-euler"}) {
+        INFO(integrator);
+        Scene scene = drape_on_cylinder();
+        apply_override(scene, std::string("integration.integrator=") + integrator);
+        MassSpring sim = build_simulation(scene);
+        const CylinderCollider& c = scene.settings.colliders.cylinder;
+        const float top = c.center.y + 0.5f * c.height, thickness = scene.settings.colliders.thickness;
+        float worst = INFINITY;
+        for (int step = 0; step < 180; ++step) {  // 3 s: falls, hits, drapes, settles
+            sim.run_steps(1);
+            for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+                worst = std::min(worst, signed_distance(c, sim.position(i)));
+            }
+        }
+        REQUIRE(sim.all_finite());
+        int on_top = 0, on_side = 0;
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+            const glm::vec3 p = sim.position(i) - c.center;
+            const float r = std::sqrt(p.x * p.x + p.z * p.z);
+            if (r < c.radius - 0.01f && std::abs(p.y + c.center.y - (top + thickness)) < 1e-4f) ++on_top;
+            if (std::abs(r - (c.radius + thickness)) < 2e-3f && p.y < 0.5f * c.height - 0.05f) ++on_side;
+        }
+        INFO("smallest clearance " << worst << " m; " << on_top << " particles on the top face, " << on_side
+                                   << " against the side");
+        CHECK(worst >= 0.0f);
+        CHECK(on_top > 100);  // the disc of radius 0.3 under a 1.2 m, 40 x 40 cloth holds about 200
+        CHECK(on_side > 0);
     }
 }

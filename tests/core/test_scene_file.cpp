@@ -202,11 +202,12 @@ TEST_CASE("scene file: an unknown section names it and lists the known top-level
         CHECK_THAT(msg, Contains(section));
     }
 
-    const std::string nested = parse_error("[colliders.cylinder]\nenabled = true\n");
+    const std::string nested = parse_error("[colliders.cone]\nenabled = true\n");
     CHECK_THAT(nested, Contains("test.toml:1:"));
-    CHECK_THAT(nested, Contains("unknown field 'colliders.cylinder'"));
+    CHECK_THAT(nested, Contains("unknown field 'colliders.cone'"));
     CHECK_THAT(nested, Contains("sphere"));
     CHECK_THAT(nested, Contains("cube"));
+    CHECK_THAT(nested, Contains("cylinder"));
     CHECK_THAT(nested, Contains("ground"));
 }
 
@@ -861,6 +862,41 @@ TEST_CASE("scene clamp_to_range: every field typed far out of range is clamped w
         const Scene reopened = parse_scene(to_toml(scene), "saved.toml");
         CHECK(reopened.settings == scene.settings);
     }
+}
+
+TEST_CASE("scene file: the cylinder collider loads, overrides, round-trips and rejects bad values") {
+    using namespace clothsim;
+    CHECK_FALSE(Scene{}.settings.colliders.cylinder.enabled);  // off unless a scene asks for it
+    const Scene s = parse_scene("[colliders.cylinder]\nenabled = true\ncenter = [0.1, 0.25, -0.2]\n"
+                                "radius = 0.09\nheight = 0.5\nfriction = 0.45\n",
+                                "test.toml");
+    const CylinderCollider& c = s.settings.colliders.cylinder;
+    CHECK(c.enabled);
+    CHECK(c.center == glm::vec3(0.1f, 0.25f, -0.2f));
+    CHECK(c.radius == 0.09f);
+    CHECK(c.height == 0.5f);
+    CHECK(c.friction == 0.45f);
+    const std::string text = to_toml(s);
+    CHECK_THAT(text, Contains("[colliders.cylinder]") && Contains("radius = 0.09") && Contains("height = 0.5"));
+    CHECK(parse_scene(text, "saved.toml").settings == s.settings);
+
+    Scene o;
+    apply_override(o, "colliders.cylinder.enabled=true");
+    apply_override(o, "colliders.cylinder.center=[0, 0.3, 0]");
+    apply_override(o, "colliders.cylinder.radius=0.09");
+    apply_override(o, "colliders.cylinder.height=0.6");
+    apply_override(o, "colliders.cylinder.friction=0");
+    CHECK(o.settings.colliders.cylinder == CylinderCollider{true, {0.0f, 0.3f, 0.0f}, 0.09f, 0.6f, 0.0f});
+
+    const std::string height = parse_error("[colliders.cylinder]\nheight = -0.1\n");
+    CHECK_THAT(height, Contains("test.toml:2:") && Contains("colliders.cylinder.height") &&
+                           Contains("a number in [0.0, 10000.0] m"));
+    Scene unchanged = o;
+    CHECK_THAT(override_error(unchanged, "colliders.cylinder.radius=-1"),
+               Contains("colliders.cylinder.radius") && Contains(allowed("colliders.cylinder.radius")));
+    CHECK_THAT(override_error(unchanged, "colliders.cylinder.friction=11"),
+               Contains("colliders.cylinder.friction") && Contains(allowed("colliders.cylinder.friction")));
+    CHECK(unchanged.settings == o.settings);
 }
 
 TEST_CASE("scene file: the contact model and its stiffness load, override, round-trip and reject bad values") {

@@ -44,6 +44,16 @@ bool moved_from(const MassSpring& sim, const std::vector<glm::vec3>& start) {
     return false;
 }
 
+// A bundled drape scene, or "drape-cylinder": drape-sphere with a cylinder where the sphere was (its top
+// where the sphere's top is).
+Scene drape_scene(const std::string& name) {
+    if (name != "drape-cylinder") return load_scene(name);
+    Scene s = load_scene("drape-sphere");
+    s.settings.colliders.sphere.enabled = false;
+    s.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
+    return s;
+}
+
 void step_n(MassSpring& sim, int substeps) {
     for (int i = 0; i < substeps; ++i) sim.step();
 }
@@ -169,26 +179,34 @@ TEST_CASE("step_plan a collider out of reach changes nothing and the broad phase
         Scene without = small_hanging(method);
         Scene far = without;
         far.settings.colliders.sphere = {true, {0.0f, -50.0f, 0.0f}, 1.0f, 0.3f};
+        far.settings.colliders.cylinder = {true, {30.0f, 1.0f, 0.0f}, 1.0f, 2.0f, 0.3f};
         MassSpring a = build_simulation(without);
         MassSpring b = build_simulation(far);
         CHECK_FALSE(a.plan().sphere);
+        CHECK_FALSE(a.plan().cylinder);
         CHECK(b.plan().sphere);
+        CHECK(b.plan().cylinder);
         step_n(a, 60);
         step_n(b, 60);
         require_same_positions(a, b);
-        // Every block of the 12 x 12 grid offered every substep; none may touch a sphere 50 m below.
-        CHECK(b.profile().blocks_offered[0] == static_cast<long long>(12 * blocks_per_row(12) * 60));
-        CHECK(b.profile().blocks_tested[0] == 0);
-        CHECK(b.profile().runs_of(Stage::Sphere) == 60);
-        CHECK(a.profile().runs_of(Stage::Sphere) == 0);
+        // Every block of the 12 x 12 grid offered every substep; none may touch a sphere 50 m below or a
+        // cylinder 30 m to the side.
+        for (Stage stage : {Stage::Sphere, Stage::Cylinder}) {
+            INFO("stage " << stage_name(stage));
+            const int c = collider_index(stage);
+            CHECK(b.profile().blocks_offered[c] == static_cast<long long>(12 * blocks_per_row(12) * 60));
+            CHECK(b.profile().blocks_tested[c] == 0);
+            CHECK(b.profile().runs_of(stage) == 60);
+            CHECK(a.profile().runs_of(stage) == 0);
+        }
     }
 }
 
 TEST_CASE("step_plan the collision broad phase on or off gives bit-identical drapes", "[step_plan]") {
-    for (const char* name : {"drape-sphere", "drape-cube"}) {
+    for (const char* name : {"drape-sphere", "drape-cube", "drape-cylinder"}) {
         for (SolverMethod method : kMethods) {
             INFO(name << ", " << method_name(method) << " solver");
-            Scene scene = load_scene(name);
+            Scene scene = drape_scene(name);
             scene.cloth.rows = 16;
             scene.cloth.cols = 16;
             scene.settings.solver.method = method;
@@ -200,7 +218,9 @@ TEST_CASE("step_plan the collision broad phase on or off gives bit-identical dra
             culled.run_steps(60);  // 1 s: the cloth has landed on the collider and drapes over it
             full.run_steps(60);
             require_same_positions(culled, full);
-            const std::size_t which = culled.settings().colliders.sphere.enabled ? 0 : 1;
+            const ColliderSettings& c = culled.settings().colliders;
+            const Stage stage = c.sphere.enabled ? Stage::Sphere : c.cube.enabled ? Stage::Cube : Stage::Cylinder;
+            const int which = collider_index(stage);
             const StepProfile& pc = culled.profile();
             const StepProfile& pf = full.profile();
             INFO("blocks tested " << pc.blocks_tested[which] << " of " << pc.blocks_offered[which]);
@@ -210,13 +230,15 @@ TEST_CASE("step_plan the collision broad phase on or off gives bit-identical dra
             CHECK(pc.blocks_tested[which] < pc.blocks_offered[which]);
             CHECK(pf.blocks_tested[which] == pf.blocks_offered[which]);
             CHECK(pf.blocks_offered[which] == pc.blocks_offered[which]);
-            CHECK(pf.blocks_tested[2] == pf.blocks_offered[2]);  // the ground too
+            const int ground = collider_index(Stage::Ground);
+            CHECK(pf.blocks_tested[ground] == pf.blocks_offered[ground]);  // the ground too
             // Draped: some particles rest on the collider.
-            const ColliderSettings& c = culled.settings().colliders;
             float closest = INFINITY;
             for (std::size_t i = 0; i < culled.particle_count(); ++i) {
                 const glm::vec3 p = culled.position(i);
-                closest = std::min(closest, which == 0 ? signed_distance(c.sphere, p) : signed_distance(c.cube, p));
+                closest = std::min(closest, stage == Stage::Sphere ? signed_distance(c.sphere, p)
+                                            : stage == Stage::Cube ? signed_distance(c.cube, p)
+                                                                   : signed_distance(c.cylinder, p));
             }
             CHECK(closest < 2.0f * c.thickness);
         }
@@ -288,9 +310,14 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     p = plan_step(t, s, true);
     CHECK((!p.sphere && p.cube && !p.ground));
     s.colliders.cube.enabled = false;
+    s.colliders.cylinder.enabled = true;
+    p = plan_step(t, s, true);
+    CHECK((!p.sphere && !p.cube && p.cylinder && !p.ground));
+    CHECK(p.any_collider());
+    s.colliders.cylinder.enabled = false;
     s.colliders.ground.enabled = true;
     p = plan_step(t, s, true);
-    CHECK((!p.sphere && !p.cube && p.ground));
+    CHECK((!p.sphere && !p.cube && !p.cylinder && p.ground));
 
     s.springs.shear = 0.0f;
     CHECK(plan_step(t, s, true).spring_mask() == 5u);
@@ -419,7 +446,7 @@ TEST_CASE("step_plan the profile counts each stage that runs once per substep an
     CHECK(p.substeps == kSubsteps);
     CHECK(p.slept_substeps == 0);
     for (Stage skipped : {Stage::Wind, Stage::StrainLimit, Stage::SpeedLimit, Stage::Springs, Stage::Integrate,
-                          Stage::Sphere, Stage::Cube, Stage::Sleep}) {
+                          Stage::Sphere, Stage::Cube, Stage::Cylinder, Stage::Sleep}) {
         INFO("stage " << stage_name(skipped));
         CHECK(p.runs_of(skipped) == 0);
         CHECK(p.ms_of(skipped) == 0.0);
@@ -429,7 +456,7 @@ TEST_CASE("step_plan the profile counts each stage that runs once per substep an
         CHECK(p.runs_of(runs) == kSubsteps);
         CHECK(p.ms_of(runs) > 0.0);
     }
-    CHECK(p.blocks_offered[2] == static_cast<long long>(12 * blocks_per_row(12) * kSubsteps));
+    CHECK(p.blocks_offered[collider_index(Stage::Ground)] == static_cast<long long>(12 * blocks_per_row(12) * kSubsteps));
 
     // The textbook path times its spring and integration stages instead of the fast solver's fused stage.
     MassSpring textbook = build_simulation(small_hanging(SolverMethod::Textbook));
@@ -475,11 +502,12 @@ void check_describe_matches_profile(const MassSpring& sim) {
     }
 }
 
-// Every optional stage on: wind, the sphere, the strain and speed limits.
+// Every optional stage on: wind, the sphere, the cylinder, the strain and speed limits.
 Scene busy(SolverMethod method) {
     Scene s = small_hanging(method);
     s.settings.forces.wind = {0.0f, 0.0f, 2.0f};
     s.settings.colliders.sphere = {true, {0.0f, 1.0f, 0.0f}, 0.3f, 0.3f};
+    s.settings.colliders.cylinder = {true, {0.3f, 0.6f, 0.0f}, 0.1f, 0.3f, 0.3f};
     s.settings.springs.strain_limit = 0.1f;
     s.settings.forces.max_speed = 20.0f;
     return s;
@@ -540,7 +568,7 @@ TEST_CASE("step_plan penalty contact runs the contact force stage instead of the
         sim.run_steps(2);
         const long long substeps = 2LL * scene.settings.integration.substeps;
         CHECK(sim.profile().runs_of(Stage::Contact) == substeps);
-        for (Stage skipped : {Stage::Sphere, Stage::Cube, Stage::Ground, Stage::BroadPhase}) {
+        for (Stage skipped : {Stage::Sphere, Stage::Cube, Stage::Cylinder, Stage::Ground, Stage::BroadPhase}) {
             INFO("stage " << stage_name(skipped));
             CHECK(sim.profile().runs_of(skipped) == 0);
         }
@@ -571,4 +599,15 @@ TEST_CASE("step_plan penalty contact runs the contact force stage instead of the
     CHECK_FALSE(plan_step(rk4.topology(), flat, true).contact);
     CHECK(status_of(describe(plan_step(rk4.topology(), flat, true), rk4.topology(), flat), Stage::Contact).note ==
           "colliders.thickness is 0");
+
+    // The cylinder is one of the colliders the contact stage pushes with, and alone it is enough for one.
+    SimulationSettings cylinder = rk4.settings();
+    cylinder.colliders.cylinder.enabled = true;
+    const std::vector<StageStatus> with = describe(plan_step(rk4.topology(), cylinder, true), rk4.topology(), cylinder);
+    CHECK(status_of(with, Stage::Contact).note.find("sphere, cylinder, ground") != std::string::npos);
+    CHECK(status_of(with, Stage::Cylinder).note.find("colliders.contact is penalty") != std::string::npos);
+    cylinder.colliders.sphere.enabled = cylinder.colliders.ground.enabled = false;
+    const StepPlan only = plan_step(rk4.topology(), cylinder, true);
+    CHECK(only.contact);
+    CHECK_FALSE(only.any_collider());
 }

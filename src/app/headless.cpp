@@ -7,6 +7,8 @@
 #include "clothsim/stepper.hpp"
 #include "clothsim/strain.hpp"
 
+#include "clothsim/drape.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -153,10 +155,11 @@ nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit) {
     const Energy e = sim.energy();
     const std::vector<StageStatus> stages = describe(sim.plan(), sim.topology(), sim.settings());
-    const nlohmann::json out = {
+    nlohmann::json out = {
         {"scene", scene.name},
         {"particles", sim.particle_count()},
         {"springs", sim.spring_count()},
+        {"bends", sim.bend_count()},
         {"steps", run.steps},
         {"substeps_per_step", sim.settings().integration.substeps},
         {"dt", sim.settings().integration.dt},
@@ -172,6 +175,14 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"max_strain", finite_or_null(max_membrane_strain(sim.topology(), sim.state().position))},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
+    // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.
+    const CylinderCollider& support = sim.settings().colliders.cylinder;
+    if (scene.cloth.shape == ClothShape::Disc && support.enabled) {
+        const DrapeFigures drape = measure_drape(sim, glm::dvec3(support.center), support.radius);
+        out["drape_coefficient"] = finite_or_null(drape.drape_coefficient);
+        out["folds"] = drape.folds;
+        out["drape_outline"] = {drape.outline_min, drape.outline_max};
+    }
     std::cout << out.dump(2) << std::endl;
 }
 

@@ -69,14 +69,14 @@ std::string shortest(double v) {
 // Bundled scenes
 // ---------------------------------------------------------------------------------------------------------
 
-TEST_CASE("scene: the bundled scene list is exactly the six shipped scenes") {
-    const std::vector<std::string> expected = {"curtain", "drape-cube", "drape-sphere", "falling", "flag", "hanging"};
+TEST_CASE("scene: the bundled scene list is exactly the seven shipped scenes") {
+    const std::vector<std::string> expected = {"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "hanging"};
     REQUIRE(clothsim::bundled_scene_names() == expected);
 }
 
 TEST_CASE("scene: every bundled scene loads, builds and stays finite for 2 simulated seconds") {
     const std::vector<std::string> names = clothsim::bundled_scene_names();
-    REQUIRE(names.size() == 6);
+    REQUIRE(names.size() == 7);
     for (const std::string& name : names) {
         INFO("scene " << name);
         const clothsim::Scene scene = clothsim::load_scene(name);

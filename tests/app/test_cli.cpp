@@ -513,7 +513,7 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CAPTURE_RUN(r);
     CHECK(r.code == 0);
     CHECK(lines_of(r.out) ==
-          std::vector<std::string>{"curtain", "drape-cube", "drape-sphere", "falling", "flag", "hanging"});
+          std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "hanging"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

@@ -4,6 +4,7 @@
 #include "clothsim/stability.hpp"
 
 #include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -350,4 +351,80 @@ TEST_CASE("material: a scene written out reads back the same, with the derived p
     CHECK(to_toml(back) == text);
     // A per-spring scene writes no [material].
     CHECK(to_toml(parse_scene("[springs]\nshear = 9\n", "p.toml")).find("[material]") == std::string::npos);
+}
+
+namespace {
+
+// `hanging` as a material at n particles a side: a 1 m square, released flat, held by two clips of 0.15 m
+// (point pins are singular, docs/MATERIAL.md), settled with damping near critical for its swing. Returns
+// the settled positions.
+std::vector<glm::dvec3> hanging_settled(int n, double seconds = 5.0, float clip = 0.15f, float bending = 1e-4f,
+                                        float damping = 6.0f, float stretch = 1000.0f) {
+    Scene s = load_scene("hanging");
+    s.per_spring_fields = 0;
+    s.cloth.rows = s.cloth.cols = n;
+    s.material.enabled = true;
+    s.material.preset.clear();
+    s.material.density = 0.2f;
+    s.material.stretch = glm::vec2(stretch);
+    s.material.shear = 50.0f;
+    s.material.bending = glm::vec2(bending);
+    s.pins.preset_radius = clip;
+    s.settings.colliders.ground.enabled = false;
+    s.settings.springs.damping = damping;  // 6: 2 sqrt(g / L), the slowest swing at critical
+    s.settings.solver.sleep_speed = 0.0f;
+    s.settings.solver.threads = 1;
+    MassSpring sim = build_simulation(s);
+    sim.set_substeps(auto_substeps(stability_limit(sim), s.settings.integration.dt, 0.8f, 1));
+    sim.run_steps(static_cast<long long>(seconds / s.settings.integration.dt));
+    std::printf("    n %d: kinetic energy %.3g J after %.1f s, %d substeps\n", n, sim.energy().kinetic, seconds,
+                sim.settings().integration.substeps);
+    std::vector<glm::dvec3> out(sim.particle_count());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = sim.state().position.get(i);
+    return out;
+}
+
+// The largest distance between two settled shapes of n and m particles a side, at the coarser grid's
+// particles (the finer shape interpolated bilinearly at the same material point).
+double shape_distance(const std::vector<glm::dvec3>& coarse, int n, const std::vector<glm::dvec3>& fine, int m) {
+    double worst = 0.0;
+    for (int r = 0; r < n; ++r) {
+        for (int c = 0; c < n; ++c) {
+            const double u = double(c) / (n - 1) * (m - 1), v = double(r) / (n - 1) * (m - 1);
+            const int c0 = std::min(static_cast<int>(u), m - 2), r0 = std::min(static_cast<int>(v), m - 2);
+            const double fu = u - c0, fv = v - r0;
+            auto at = [&](int rr, int cc) { return fine[static_cast<std::size_t>(rr) * m + cc]; };
+            const glm::dvec3 p = (1 - fv) * ((1 - fu) * at(r0, c0) + fu * at(r0, c0 + 1)) +
+                                 fv * ((1 - fu) * at(r0 + 1, c0) + fu * at(r0 + 1, c0 + 1));
+            worst = std::max(worst, glm::length(p - coarse[static_cast<std::size_t>(r) * n + c]));
+        }
+    }
+    return worst;
+}
+
+}  // namespace
+
+TEST_CASE("material: hanging settled at 17, 33 and 65 particles a side converges to one shape: the distance between "
+          "successive resolutions shrinks by at least 30% per doubling (the issue's factor 2 is not reached: "
+          "docs/MATERIAL.md)", "[material]") {
+    // Point pins (clip 0): nested grids, the pins on the same material points.
+    const auto a = hanging_settled(17, 5.0, 0.0f), b = hanging_settled(33, 5.0, 0.0f), c = hanging_settled(65, 5.0, 0.0f);
+    const double d1 = shape_distance(a, 17, b, 33), d2 = shape_distance(b, 33, c, 65);
+    INFO("17 -> 33: " << d1 << " m, 33 -> 65: " << d2 << " m");
+    CHECK(d1 < 0.02);
+    CHECK(d2 <= 0.7 * d1);
+}
+
+TEST_CASE("material study: resolution independence of hanging", "[material][.study]") {
+    struct Case { double seconds; float clip, bending, damping, stretch; };
+    for (const Case& c : {Case{5, 0.0f, 1e-4f, 6, 1000}, Case{5, 0.15f, 1e-4f, 6, 1000}, Case{5, 0.0f, 1e-5f, 6, 4000}}) {
+        std::printf("settle %.0f s, clip %.2f m, B %g N m, damping %g, stretch %g:\n", c.seconds, c.clip, c.bending,
+                    c.damping, c.stretch);
+        const auto a = hanging_settled(17, c.seconds, c.clip, c.bending, c.damping, c.stretch);
+        const auto b = hanging_settled(33, c.seconds, c.clip, c.bending, c.damping, c.stretch);
+        const auto d = hanging_settled(65, c.seconds, c.clip, c.bending, c.damping, c.stretch);
+        const auto e = hanging_settled(129, c.seconds, c.clip, c.bending, c.damping, c.stretch);
+        std::printf("  17 -> 33: %.4g m, 33 -> 65: %.4g m, 65 -> 129: %.4g m\n", shape_distance(a, 17, b, 33),
+                    shape_distance(b, 33, d, 65), shape_distance(d, 65, e, 129));
+    }
 }

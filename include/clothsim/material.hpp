@@ -69,9 +69,11 @@ struct SpringConstants {
     double poisson_uv = 0.0;  // contraction along v per stretch along u, uniaxial
     double poisson_vu = 0.0;
     double total_mass = 0.0;  // kg: density x the area of the shape's cells
+    // Empty, or why the membrane is stiffer than asked along an axis (long thin cells: the diagonals alone
+    // exceed the stretch there; the structural springs of that axis are 0).
+    std::string note;
 };
-// Throws SceneError when the grid has a single row or column (no cells), or when the shear is so large
-// against the stretch at this cell aspect that a structural spring would need a negative k.
+// Throws SceneError when the grid has a single row or column (no cells).
 SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSettings& material);
 
 // Bookkeeping after one field of `scene` was set (by a file, --set or the panel): a material field puts the

@@ -285,6 +285,7 @@ bool material_section(Scene& edit, AppState& app) {
             ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g, bends %.4g / %.4g N/m",
                                 k.structural.x, k.structural.y, k.shear, k.bending.x, k.bending.y);
             ImGui::TextDisabled("Poisson ratio %.3f / %.3f", k.poisson_uv, k.poisson_vu);
+            if (!k.note.empty()) ImGui::TextWrapped("%s", k.note.c_str());
         } catch (const SceneError& e) {
             ImGui::TextWrapped("%s", e.what());
         }

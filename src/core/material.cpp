@@ -4,8 +4,12 @@
 #include "clothsim/scene.hpp"
 
 #include <array>
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <cstdio>
+#include <string>
+#include <string_view>
 
 namespace clothsim {
 namespace {
@@ -96,19 +100,25 @@ SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSetti
     const double r = su / sv;
     const double c22 = (su + std::sqrt(su * su + 4.0 * r * g * g)) / (2.0 * r);
     const double c11 = r * c22;
-    const double au = c11 - g * (hu / hv) * (hu / hv);
-    const double av = c22 - g * (hv / hu) * (hv / hu);
-    if (au < 0.0 || av < 0.0) {
-        throw SceneError("material.shear = " + show(g) + " N/m is too large for material.stretch = [" + show(su) + ", " +
-                         show(sv) + "] N/m on cells of " + show(hu) + " x " + show(hv) +
-                         " m: the diagonal springs alone would be stiffer in tension; allowed: a smaller shear, or "
-                         "cells closer to square (cloth.size / (cloth.cols - 1, cloth.rows - 1))");
+    double au = c11 - g * (hu / hv) * (hu / hv);
+    double av = c22 - g * (hv / hu) * (hv / hu);
+    // On long thin cells the diagonals alone may be stiffer in tension along the short side than the stretch
+    // asked for: the structural springs there cannot be negative, so that axis comes out stiffer than asked.
+    const bool clamp_u = au < 0.0, clamp_v = av < 0.0;
+    au = std::max(au, 0.0), av = std::max(av, 0.0);
+    const double cu = au + g * (hu / hv) * (hu / hv), cv = av + g * (hv / hu) * (hv / hu);
+    for (const auto& [clamped, axis, got, asked] :
+         {std::tuple{clamp_u, "u", cu - g * g / cv, su}, std::tuple{clamp_v, "v", cv - g * g / cu, sv}}) {
+        if (!clamped) continue;
+        out.note += std::string(out.note.empty() ? "" : "; ") + "on cells of " + show(hu) + " x " + show(hv) +
+                    " m the diagonals alone (material.shear = " + show(g) + " N/m) give a stretch of " + show(got) +
+                    " N/m along " + axis + ", more than the " + show(asked) + " asked: make the cells closer to square";
     }
     out.structural = {au * hv / hu, av * hu / hv};
     out.shear = g * (hu * hu + hv * hv) / (2.0 * hu * hv);
     out.bending = {double(material.bending.x) * hv / (hu * hu * hu), double(material.bending.y) * hu / (hv * hv * hv)};
-    out.poisson_uv = g / c22;
-    out.poisson_vu = g / c11;
+    out.poisson_uv = g / cv;
+    out.poisson_vu = g / cu;
     out.total_mass = double(material.density) * hu * hv * double(shape_mask(cloth).cell_count);
     return out;
 }

@@ -506,6 +506,11 @@ void apply_override(Scene& scene, std::string_view assignment) {
 
 std::string to_toml(const Scene& scene) {
     std::string out = "# clothsim scene (fields, units and ranges: README.md, \"Scene files\")\n";
+    if (scene.material.enabled && scene.cloth.rows > 1 && scene.cloth.cols > 1) {
+        if (const std::string note = spring_constants(scene.cloth, scene.material).note; !note.empty()) {
+            out += "# material: " + note + "\n";
+        }
+    }
     // In the material form the per-spring fields are derived: shown as comments, not read back.
     auto line = [&](const FieldInfo& f, std::string_view key) -> std::string {
         const std::string text = std::string(key) + " = " + format_value(scene, f);

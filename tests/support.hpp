@@ -59,4 +59,19 @@ void edit_settings(clothsim::MassSpring& sim, Edit edit) {
     sim.apply(settings);
 }
 
+// A Cusick specimen: a 30 cm disc of n x n grid particles lying flat at y = 1, centred on the y axis,
+// nothing pinned, ground off.
+inline Scene disc_specimen(int n) {
+    Scene s;
+    s.cloth.rows = s.cloth.cols = n;
+    s.cloth.size = {0.3f, 0.3f};
+    s.cloth.origin = {-0.15f, 1.0f, -0.15f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    s.cloth.shape = ClothShape::Disc;
+    s.pins.preset = PinPreset::None;
+    s.settings.colliders.ground.enabled = false;
+    return s;
+}
+
 }  // namespace clothsim::test

@@ -15,17 +15,9 @@ using namespace clothsim;
 namespace {
 
 Scene disc_scene(int n, bool material) {
-    Scene s;
-    s.cloth.rows = s.cloth.cols = n;
-    s.cloth.size = {0.3f, 0.3f};
-    s.cloth.origin = {-0.15f, 1.0f, -0.15f};
-    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
-    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
-    s.cloth.shape = ClothShape::Disc;
+    Scene s = test::disc_specimen(n);
     // Held at its centre, as the Cusick tester's clamp discs hold the specimen.
-    s.pins.preset = PinPreset::None;
     s.pins.particles = {{n / 2, n / 2}};
-    s.settings.colliders.ground.enabled = false;
     s.settings.solver.sleep_speed = 0.0f;
     if (material) {
         s.material.enabled = true;

@@ -1,6 +1,7 @@
 // The Cusick drape test's figures from a cloth's shadow (drape.hpp), on shapes whose shadow is known exactly.
 #include "clothsim/drape.hpp"
 #include "clothsim/scene.hpp"
+#include "support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -11,18 +12,7 @@ using namespace clothsim;
 
 namespace {
 
-// A 30 cm disc specimen of n x n particles, flat at y = 1, centred on the y axis.
-MassSpring specimen(int n = 65) {
-    Scene s;
-    s.cloth.rows = s.cloth.cols = n;
-    s.cloth.size = {0.3f, 0.3f};
-    s.cloth.origin = {-0.15f, 1.0f, -0.15f};
-    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
-    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
-    s.cloth.shape = ClothShape::Disc;
-    s.pins.preset = PinPreset::None;
-    return build_simulation(s);
-}
+MassSpring specimen(int n = 65) { return build_simulation(test::disc_specimen(n)); }
 
 // Moves every particle of the ring outside `support` (polar r, phi about the axis) to the horizontal radius
 // support + (r - support) spread(phi), dropping the rest of its length straight down.

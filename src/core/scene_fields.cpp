@@ -2,6 +2,7 @@
 // to_toml(), the README's field list and the panel's tooltips all read this table.
 #include "clothsim/scene.hpp"
 
+#include "clothsim/cloth_shape.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
@@ -248,6 +249,11 @@ void validate(const Scene& scene) {
     if (!(lv > 1e-6f)) throw SceneError("cloth.v_axis = " + format_value(scene, *find_field("cloth.v_axis")) + " has no direction; allowed: a non-zero vector");
     if (glm::length(glm::cross(c.u_axis / lu, c.v_axis / lv)) < 1e-3f) {
         throw SceneError("cloth.u_axis and cloth.v_axis are parallel; allowed: two non-parallel directions");
+    }
+    if (c.shape == ClothShape::Disc && shape_mask(c).cell_count == 0) {
+        throw SceneError("cloth.shape = \"disc\" keeps no whole cell of the " + std::to_string(c.rows) + " x " +
+                         std::to_string(c.cols) + " grid; allowed: a grid whose inscribed circle holds a cell (5 x 5 "
+                         "particles or more)");
     }
     if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
     if (scene.material.enabled) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive

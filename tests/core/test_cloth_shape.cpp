@@ -160,3 +160,12 @@ TEST_CASE("cloth shape: every integrator leaves a disc's absent particles where 
         CHECK(sim.state().position.get(corner) == start.state().position.get(corner));
     }
 }
+
+TEST_CASE("cloth shape: a disc too small to hold a whole cell is refused with a message", "[cloth_shape]") {
+    CHECK_THROWS_WITH(parse_scene("[cloth]\nrows = 9\ncols = 3\nshape = \"disc\"\n", "d.toml"),
+                      Catch::Contains("d.toml:4") && Catch::Contains("keeps no whole cell of the 9 x 3 grid"));
+    Scene s = parse_scene("[cloth]\nrows = 9\ncols = 9\nshape = \"disc\"\n[material]\npreset = \"silk\"\n", "e.toml");
+    CHECK_THROWS_WITH(apply_override(s, "cloth.cols=3"), Catch::Contains("--set cloth.cols=3"));
+    CHECK(s.cloth.cols == 9);
+    CHECK(shape_mask(s.cloth).cell_count > 0);
+}

@@ -73,9 +73,8 @@ TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solv
 
 TEST_CASE("fast solver: a material cloth (bends, half-weight edges, warp and weft) agrees with the textbook solver "
           "bit for bit with every kernel and thread count", "[fast_solver][material]") {
-    Scene scene = load_scene("hanging");
-    scene.per_spring_fields = 0;  // the file's per-spring values give way to the material below
-    scene.cloth.rows = 40;        // blocks of 8 rows and more for up to 5 threads
+    Scene scene = load_scene("hanging");  // its cotton gives way to the fabric set field by field below
+    scene.cloth.rows = 40;                // blocks of 8 rows and more for up to 5 threads
     scene.cloth.cols = 37;        // not a multiple of 8: every kernel's tail runs
     scene.material.enabled = true;
     scene.material.density = 0.2f;

@@ -2,6 +2,7 @@
 // input is rejected with a message naming its source, line, field and allowed values, and nothing is
 // ever half-applied.
 #include "clothsim/overloaded.hpp"
+#include "clothsim/material.hpp"
 #include "clothsim/scene.hpp"
 
 #include "per_spring_scenes.hpp"
@@ -110,7 +111,16 @@ TEST_CASE("scene: a bundled scene loads the values written in its file") {
     CHECK(s.pins.particles.empty());
     CHECK(s.settings.forces.wind.x == 8.0f);
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Triangles);
-    CHECK(s.settings.integration.substeps == 40);
+    CHECK(s.settings.integration.substeps == 145);
+    // Its fabric is a preset: the material fields are the preset's, and the mass is derived from its density.
+    const clothsim::MaterialPreset* polyester = clothsim::find_material_preset("polyester");
+    REQUIRE(polyester);
+    CHECK(s.material.enabled);
+    CHECK(s.material.preset == "polyester");
+    CHECK(s.material.density == polyester->density);
+    CHECK(s.material.stretch == polyester->stretch);
+    CHECK(s.per_spring_fields == 0);
+    CHECK(s.cloth.mass == Approx(polyester->density * 1.5f * 1.0f));
     // A field a file leaves out keeps its default.
     CHECK(s.settings.colliders.thickness == clothsim::ColliderSettings{}.thickness);
 }

@@ -7,6 +7,8 @@
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
+#include "per_spring_scenes.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -80,8 +82,10 @@ Pair time_pair(const std::function<void()>& frame_a, const std::function<void()>
 
 // A bundled scene with its cloth resized, and the substeps a finer grid needs to stay stable (0.67 of the
 // critical substep, as the bundled scenes are set).
+// In its per-spring form (tests/per_spring_scenes.hpp): the workload docs/PERFORMANCE.md's figures measured,
+// and the zero-stiffness cases switch skip-one bending springs off.
 Scene resized(const std::string& name, int size) {
-    Scene s = load_scene(name);
+    Scene s = per_spring_scene(name);
     s.cloth.rows = s.cloth.cols = size;
     s.settings.solver.sleep_speed = 0.0f;  // awake throughout unless a case says otherwise
     const MassSpring sim = build_simulation(s);

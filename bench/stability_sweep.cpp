@@ -5,6 +5,8 @@
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
+#include "per_spring_scenes.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,7 +28,8 @@ struct Case {
 };
 
 Scene scene_for(const Case& c, double h) {
-    Scene s = load_scene("hanging");  // released flat, held by two corners: it moves from the first step
+    // Released flat, held by two corners: it moves from the first step. Per spring: the mass and springs below.
+    Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = c.grid;
     s.cloth.mass = c.mass;
     s.settings.springs.structural = glm::vec2(c.stiffness);

@@ -5,6 +5,8 @@
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
 
+#include "per_spring_scenes.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,13 +21,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The study's scenes: small versions of bundled ones, so the double-precision reference is affordable.
+// The study's scenes: small versions of bundled ones, so the double-precision reference is affordable, in the
+// per-spring form docs/ACCURACY.md's figures measured (tests/per_spring_scenes.hpp).
 //  smooth: hanging, 16 x 16, no ground, no damping (smooth and conservative: energy error is meaningful)
 //  drape:  drape-sphere, 16 x 16, damped, with sphere and ground contact, penalty model (smooth; see below)
 //  flag:   flag, 12 x 18, wind with gusts
 Scene study_scene(const std::string& name) {
     if (name == "smooth") {
-        Scene s = load_scene("hanging");
+        Scene s = per_spring_scene("hanging");
         s.cloth.rows = s.cloth.cols = 16;
         s.settings.colliders.ground.enabled = false;
         s.settings.springs.damping = 0.0f;
@@ -33,7 +36,7 @@ Scene study_scene(const std::string& name) {
         return s;
     }
     if (name == "drape") {
-        Scene s = load_scene("drape-sphere");
+        Scene s = per_spring_scene("drape-sphere");
         s.cloth.rows = s.cloth.cols = 16;
         // Penalty contact, so the error has a limit to converge to (projection contact's reference does not
         // converge: docs/ACCURACY.md, "Contact in the accuracy study"). k_c = 1e4 N/m: a particle of this cloth
@@ -48,7 +51,7 @@ Scene study_scene(const std::string& name) {
         return s;
     }
     if (name == "flag") {
-        Scene s = load_scene("flag");
+        Scene s = per_spring_scene("flag");
         s.cloth.rows = 12;
         s.cloth.cols = 18;
         s.name = "flag";

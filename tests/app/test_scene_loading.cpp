@@ -1,6 +1,7 @@
 // open_scene: what the panel's Open does. A rejected file changes nothing the user has.
 #include "scene_loading.hpp"
 
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -16,10 +17,11 @@ namespace {
 
 const std::filesystem::path kData = CLOTHSIM_TEST_DATA;
 
+// hanging in the per-spring form, whose springs.structural the user edits (a material scene derives it).
 struct Session {
     Scene edited, loaded;
     MassSpring sim;
-    Session() : edited(load_scene("hanging")), loaded(edited), sim(build_simulation(edited)) {
+    Session() : edited(per_spring_scene("hanging")), loaded(edited), sim(build_simulation(edited)) {
         edited.settings.springs.structural = glm::vec2(123.0f);  // the user's edit, not yet saved
         sim.run_steps(3);
     }
@@ -79,8 +81,9 @@ TEST_CASE("open_scene: a good file replaces the edited scene, the reset target a
 }
 
 TEST_CASE("running_scene: a panel change reaches the next substep and is what Save writes") {
-    // What the panel does with an edit: the simulation's one call, MassSpring::apply.
-    Scene document = load_scene("hanging");
+    // What the panel does with an edit: the simulation's one call, MassSpring::apply. Per spring: the edit below
+    // is to springs.structural, which Save writes only for a scene in that form.
+    Scene document = per_spring_scene("hanging");
     // One substep per step: a long substep makes the first fall (g h^2) large against float round-off.
     document.settings.integration.substeps = 1;
     MassSpring sim = build_simulation(document);

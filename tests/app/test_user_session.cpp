@@ -2,6 +2,7 @@
 // keys and clicks (user_session.hpp), never with --frames. The frames a user sees before the first physics
 // step (a fast first frame, a paused app, Reset or a scene opened while paused, a click before the cloth
 // moves) are drawn from the cloth that is loaded, whatever debug view is on.
+#include "per_spring_scenes.hpp"
 #include "run_process.hpp"
 #include "screen.hpp"
 #include "user_session.hpp"
@@ -14,6 +15,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -185,10 +187,13 @@ TEST_CASE("user session: ctrl+click on a pin and a grab before the first step, w
 }
 
 TEST_CASE("user session: a launch whose first step the guard rejects keeps drawing and quits with exit 0") {
+    // flag in the per-spring form, from a file (as in the render test of a rejected first step).
     for (const char* set : {"springs.structural=1e9", "forces.gravity=[0,-100000,0]", "cloth.size=0.001"}) {
         INFO("--set " << set);
         const TempDir dir("session_guard");
-        const RunResult r = run_user_session(dir, {"--scene", "flag", "--set", set, "--view", kEveryDebugView},
+        const fs::path flag = dir / "flag-per-spring.toml";
+        std::ofstream(flag) << clothsim::to_toml(clothsim::per_spring_scene("flag"));
+        const RunResult r = run_user_session(dir, {"--scene", flag.string(), "--set", set, "--view", kEveryDebugView},
                                              "settle\nsettle\nquit\n");
         CAPTURE_RUN(r);
         CHECK(r.code == 0);

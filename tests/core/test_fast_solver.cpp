@@ -1,6 +1,7 @@
 // The fast solver against the textbook solver (the oracle), determinism across thread counts, and
 // the fallbacks (generic kernel, non-grid topologies).
 #include "fast_solver.hpp"
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include "clothsim/colliders.hpp"
@@ -58,8 +59,9 @@ TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solv
         if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
         const FastKernel was = FastSolver::use_kernel(kernel);
         REQUIRE(FastSolver::kernel() == kernel);
+        // Per spring: the skip-one springs' sweeps (the material's bends with every kernel: the next test).
         for (const char* name : {"hanging", "drape-sphere", "flag"}) {
-            const Scene scene = load_scene(name);
+            const Scene scene = per_spring_scene(name);
             const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
             const MassSpring fast = run(scene, SolverMethod::Fast, 2, 1000);
             INFO(name << " with the " << FastSolver::kernel_name() << " kernel");
@@ -71,9 +73,8 @@ TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solv
 
 TEST_CASE("fast solver: a material cloth (bends, half-weight edges, warp and weft) agrees with the textbook solver "
           "bit for bit with every kernel and thread count", "[fast_solver][material]") {
-    Scene scene = load_scene("hanging");
-    scene.per_spring_fields = 0;  // the file's per-spring values give way to the material below
-    scene.cloth.rows = 40;        // blocks of 8 rows and more for up to 5 threads
+    Scene scene = load_scene("hanging");  // its cotton gives way to the fabric set field by field below
+    scene.cloth.rows = 40;                // blocks of 8 rows and more for up to 5 threads
     scene.cloth.cols = 37;        // not a multiple of 8: every kernel's tail runs
     scene.material.enabled = true;
     scene.material.density = 0.2f;
@@ -100,7 +101,7 @@ TEST_CASE("fast solver: a material cloth (bends, half-weight edges, warp and wef
 
 TEST_CASE("fast solver gives bit-identical positions for any thread count", "[fast_solver]") {
     for (const char* name : {"flag", "drape-cube", "curtain"}) {
-        Scene scene = load_scene(name);
+        Scene scene = per_spring_scene(name);  // the material's thread counts: the test above
         scene.cloth.rows = 64;  // enough rows for several blocks (8 rows at least each)
         scene.cloth.cols = 48;
         const MassSpring one = run(scene, SolverMethod::Fast, 1, 300);
@@ -118,7 +119,8 @@ TEST_CASE("fast solver agrees with the textbook solver bit for bit on a cloth dr
     // drape-sphere with a cylinder where the sphere was, its top face where the sphere's top is: 1000
     // substeps take the cloth onto the top face, over the rim and down the side, through the broad phase
     // (the fast solver's block boxes) and the cylinder's projection with friction and continuous collision.
-    Scene scene = load_scene("drape-sphere");
+    // Per spring: at its 38 substeps a step 1000 substeps are 0.44 s, enough to fall that far.
+    Scene scene = per_spring_scene("drape-sphere");
     scene.settings.colliders.sphere.enabled = false;
     scene.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
     const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
@@ -141,7 +143,7 @@ TEST_CASE("fast solver agrees with the textbook solver bit for bit on a cloth dr
 }
 
 TEST_CASE("fast solver keeps pins fixed and every particle outside the colliders", "[fast_solver]") {
-    Scene scene = load_scene("drape-sphere");
+    Scene scene = per_spring_scene("drape-sphere");  // 38 substeps a step: 120 steps stay short
     scene.pins.particles = {{0, 0}, {39, 39}};
     MassSpring sim = run(scene, SolverMethod::Fast, 2, 0);
     const glm::vec3 a = sim.position(0), b = sim.position(39 * 40 + 39);
@@ -199,7 +201,7 @@ TEST_CASE("fast solver is only used for grid topologies; others run the textbook
 TEST_CASE("fast solver steps every row block when OpenMP gives fewer threads than blocks", "[fast_solver]") {
     // Inside an active parallel region (nested parallelism off by default) the solver's own region gets a
     // team of one thread: every block must still be stepped, and bit-identically.
-    Scene scene = load_scene("hanging");
+    Scene scene = per_spring_scene("hanging");  // 64 x 32 at the scene's substeps: stable per spring
     scene.cloth.rows = 64;
     const MassSpring one = run(scene, SolverMethod::Fast, 1, 100);
     scene.settings.solver.method = SolverMethod::Fast;
@@ -258,7 +260,8 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
           "integrator", "[fast_solver]") {
     // Every move made outside the fast solver's sweep must be what its next substep reads: the same actions
     // on the textbook solver give the same bits. Each action comes where nothing else moves a particle.
-    Scene scene = load_scene("drape-sphere");
+    // Per spring: at 38 substeps a step the 1500 substeps below reach the sphere.
+    Scene scene = per_spring_scene("drape-sphere");
     scene.cloth.rows = scene.cloth.cols = 24;
     scene.pins.particles = {{0, 0}};
     auto script = [&](SolverMethod method, int threads) {

@@ -5,6 +5,7 @@
 #include "clothsim/stability.hpp"
 #include "clothsim/stepper.hpp"
 
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -70,7 +71,7 @@ TEST_CASE("grab a hard drag of curtain pulls the cloth along: no guard retry, bo
 
 TEST_CASE("grab a drag with structural and shear at 0, and of a 2048 x 1 chain, never trips the guard", "[grab]") {
     SECTION("bending springs only") {
-        Scene scene = load_scene("curtain");
+        Scene scene = per_spring_scene("curtain");  // skip-one bending springs: a per-spring topology
         scene.settings.springs.structural = glm::vec2(0.0f);
         scene.settings.springs.shear = 0.0f;
         MassSpring sim = build_simulation(scene);
@@ -80,7 +81,7 @@ TEST_CASE("grab a drag with structural and shear at 0, and of a 2048 x 1 chain, 
         CHECK(sim.all_finite());
     }
     SECTION("a long chain") {
-        Scene scene = load_scene("hanging");
+        Scene scene = per_spring_scene("hanging");  // a material needs cells: a chain is per spring
         scene.cloth.rows = 2048;
         scene.cloth.cols = 1;
         scene.cloth.size = {0.01f, 2.0f};
@@ -122,7 +123,7 @@ TEST_CASE("grab every integrator and solver path feels the grab", "[grab]") {
                             "integration.integrator=rk4", "integration.integrator=implicit-euler",
                             "integration.integrator=xpbd"}) {
         INFO(set);
-        Scene scene = load_scene("hanging");
+        Scene scene = per_spring_scene("hanging");  // 34 substeps a step: implicit Euler's solves stay cheap
         apply_override(scene, set);
         MassSpring pulled = build_simulation(scene);
         MassSpring free = pulled;

@@ -1,4 +1,5 @@
 // The double-precision reference solution and what the accuracy study claims for the float simulation.
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include "clothsim/reference.hpp"
@@ -16,7 +17,7 @@ namespace {
 
 // The accuracy study's smooth scene (bench/work_precision.cpp): hanging, 16 x 16, no ground, no damping.
 Scene smooth_scene() {
-    Scene s = load_scene("hanging");
+    Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 16;
     s.settings.colliders.ground.enabled = false;
     s.settings.springs.damping = 0.0f;
@@ -83,7 +84,7 @@ namespace {
 
 // The accuracy study's contact scene in small: drape-sphere, 8 x 8, sphere and ground, damped.
 Scene small_drape(ContactModel model) {
-    Scene s = load_scene("drape-sphere");
+    Scene s = per_spring_scene("drape-sphere");
     s.cloth.rows = s.cloth.cols = 8;
     s.settings.colliders.contact = model;
     return s;

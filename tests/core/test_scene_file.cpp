@@ -2,7 +2,10 @@
 // input is rejected with a message naming its source, line, field and allowed values, and nothing is
 // ever half-applied.
 #include "clothsim/overloaded.hpp"
+#include "clothsim/material.hpp"
 #include "clothsim/scene.hpp"
+
+#include "per_spring_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -108,7 +111,16 @@ TEST_CASE("scene: a bundled scene loads the values written in its file") {
     CHECK(s.pins.particles.empty());
     CHECK(s.settings.forces.wind.x == 8.0f);
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Triangles);
-    CHECK(s.settings.integration.substeps == 40);
+    CHECK(s.settings.integration.substeps == 145);
+    // Its fabric is a preset: the material fields are the preset's, and the mass is derived from its density.
+    const clothsim::MaterialPreset* polyester = clothsim::find_material_preset("polyester");
+    REQUIRE(polyester);
+    CHECK(s.material.enabled);
+    CHECK(s.material.preset == "polyester");
+    CHECK(s.material.density == polyester->density);
+    CHECK(s.material.stretch == polyester->stretch);
+    CHECK(s.per_spring_fields == 0);
+    CHECK(s.cloth.mass == Approx(polyester->density * 1.5f * 1.0f));
     // A field a file leaves out keeps its default.
     CHECK(s.settings.colliders.thickness == clothsim::ColliderSettings{}.thickness);
 }
@@ -397,7 +409,7 @@ TEST_CASE("scene override: a rejected override leaves the scene exactly as it wa
 }
 
 TEST_CASE("scene override: ints, floats, vectors, booleans, strings and bare words") {
-    clothsim::Scene s = clothsim::load_scene("hanging");
+    clothsim::Scene s = clothsim::per_spring_scene("hanging");  // springs.structural may be set below
 
     clothsim::apply_override(s, "cloth.rows=8");
     CHECK(s.cloth.rows == 8);
@@ -834,7 +846,9 @@ TEST_CASE("scene clamp_to_range: every field typed far out of range is clamped w
     using namespace clothsim;
     for (double typed : {1e9, -1e9, std::nan(""), 1e-30, -1e-30}) {
         INFO("typed " << typed);
-        Scene scene = load_scene("flag");
+        // Per spring: every typed field is one the scene holds itself (a material derives cloth.mass and the
+        // springs, and validate() checks the derived mass against cloth.mass's range).
+        Scene scene = per_spring_scene("flag");
         int notes = 0;
         for (const FieldInfo& f : scene_fields()) {
             std::visit(Overloaded{

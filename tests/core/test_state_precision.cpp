@@ -4,6 +4,7 @@
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
 
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -20,7 +21,7 @@ constexpr float kStep = 1.0f / 60.0f;  // s: the bundled scenes' step
 
 // The smooth scene of the accuracy study: hanging with the ground off (no contact), at side x side.
 Scene smooth_scene(int side) {
-    Scene s = load_scene("hanging");
+    Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = side;
     s.settings.colliders.ground.enabled = false;
     s.settings.integration.dt = kStep;

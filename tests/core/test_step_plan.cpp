@@ -1,5 +1,6 @@
 // The step plan: a stage that would do nothing is skipped, and skipping it changes no bit of the result
 // (step_plan.hpp). Also what plan_step() and describe() report, and the per-stage profile.
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include "clothsim/broad_phase.hpp"
@@ -45,10 +46,11 @@ bool moved_from(const MassSpring& sim, const std::vector<glm::vec3>& start) {
 }
 
 // A bundled drape scene, or "drape-cylinder": drape-sphere with a cylinder where the sphere was (its top
-// where the sphere's top is).
+// where the sphere's top is). In the per-spring form: the broad phase is what differs, and 38 substeps a step
+// keep these runs as short as they were before the scenes moved to [material].
 Scene drape_scene(const std::string& name) {
-    if (name != "drape-cylinder") return load_scene(name);
-    Scene s = load_scene("drape-sphere");
+    if (name != "drape-cylinder") return per_spring_scene(name);
+    Scene s = per_spring_scene("drape-sphere");
     s.settings.colliders.sphere.enabled = false;
     s.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
     return s;
@@ -58,9 +60,11 @@ void step_n(MassSpring& sim, int substeps) {
     for (int i = 0; i < substeps; ++i) sim.step();
 }
 
-// The hanging cloth, small, with sleeping off so that only the stage under test differs between runs.
+// The hanging cloth, small, with sleeping off so that only the stage under test differs between runs. In the
+// per-spring form: these tests switch spring kinds off through settings.springs, which a material scene
+// derives again from its [material] at every build.
 Scene small_hanging(SolverMethod method, int n = 12) {
-    Scene s = load_scene("hanging");
+    Scene s = per_spring_scene("hanging");
     s.cloth.rows = n;
     s.cloth.cols = n;
     s.settings.solver.method = method;
@@ -251,7 +255,7 @@ TEST_CASE("step_plan the collision broad phase on or off gives bit-identical dra
     // the last substep no longer bound them, so the broad phase must not reuse them.
     for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::Rk4, Integrator::Xpbd}) {
         INFO("integrator " << static_cast<int>(integrator));
-        Scene scene = load_scene("drape-sphere");
+        Scene scene = drape_scene("drape-sphere");
         scene.cloth.rows = 16;
         scene.cloth.cols = 16;
         scene.settings.integration.integrator = integrator;

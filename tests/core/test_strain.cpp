@@ -1,5 +1,6 @@
 // Spring strain (strain.hpp), and what it shows about pins: a point pin is a singular load whose strain grows
 // as the grid is refined, a clip of fixed size in metres spreads the load over its rim.
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include "clothsim/strain.hpp"
@@ -53,7 +54,7 @@ struct PinStrain {
 // `hanging` at n x n particles, without the ground, settled: 4 s with damping 2/s leaves a kinetic energy
 // under 1e-3 J and strains that change by less than 0.1% (checked by hand at 6 s).
 PinStrain settled_hanging(int n, float clip_radius) {
-    Scene s = load_scene("hanging");
+    Scene s = per_spring_scene("hanging");  // the per-spring constants docs/MATERIAL.md's pin table used
     s.cloth.rows = n;
     s.cloth.cols = n;
     s.settings.colliders.ground.enabled = false;

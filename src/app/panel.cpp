@@ -218,7 +218,7 @@ void note_edit(Scene& edit, const FieldInfo& f) {
 bool fields_section(Scene& edit, AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
-        if (!f.name.starts_with(prefix) || f.name == "material.preset") continue;
+        if (!f.name.starts_with(prefix) || f.name == "material.preset" || f.name == "material.enabled") continue;
         // Auto substeps owns the substeps field, and a material the per-spring values: greyed out so an edit
         // is not silently overwritten.
         const bool owned = (app.stepper.policy().auto_substeps && f.name == "integration.substeps") ||
@@ -247,14 +247,16 @@ bool material_section(Scene& edit, AppState& app) {
     if (ImGui::BeginCombo("fabric", current.c_str())) {
         auto choose = [&](const std::string& name) {
             if (name == "per spring") {
-                // Back to springs: the loaded scene's when it had them, else the built-in defaults.
-                const SpringSettings springs = app.loaded.material.enabled ? SpringSettings{} : app.loaded.settings.springs;
-                edit.settings.springs.structural = springs.structural;
-                edit.settings.springs.shear = springs.shear;
-                edit.settings.springs.bending = springs.bending;
-                edit.cloth.mass = app.loaded.material.enabled ? Scene{}.cloth.mass : app.loaded.cloth.mass;
+                // Back to springs: the loaded scene's when it had them, else those derived on this grid (as
+                // --set material.enabled=false does).
                 edit.material.enabled = false;
-                edit.material.preset.clear();
+                note_edit(edit, *find_field("material.enabled"));
+                if (!app.loaded.material.enabled) {
+                    edit.settings.springs.structural = app.loaded.settings.springs.structural;
+                    edit.settings.springs.shear = app.loaded.settings.springs.shear;
+                    edit.settings.springs.bending = app.loaded.settings.springs.bending;
+                    edit.cloth.mass = app.loaded.cloth.mass;
+                }
             } else {
                 edit.per_spring_fields = 0;
                 edit.material.enabled = true;

@@ -125,6 +125,11 @@ SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSetti
 
 void note_field_set(Scene& scene, std::string_view field) {
     MaterialSettings& m = scene.material;
+    if (field == "material.enabled") {
+        // Off: the per-spring form, holding the mass and constants last derived; nothing of the material is kept.
+        if (!m.enabled) m = MaterialSettings{};
+        return;
+    }
     if (field == "material.preset") {
         m.enabled = true;
         apply_preset(m);
@@ -173,6 +178,7 @@ bool field_is_written(const Scene& scene, std::string_view field) {
     const MaterialSettings& m = scene.material;
     if (field.starts_with("material.")) {
         if (!m.enabled) return false;
+        if (field == "material.enabled") return true;
         if (field == "material.preset") return !m.preset.empty();
         for (const FieldBit& f : kMaterialFields) {
             if (field == f.name) return m.preset.empty() || (m.explicit_fields & f.bit);

@@ -35,6 +35,7 @@ const std::array kFields = {
     FieldInfo{"cloth.shape", "", 0, 0, "rectangle: the whole grid; disc: the particles inside the grid's inscribed circle (a Cusick drape specimen)", [](Scene& s) -> FieldRef { return &s.cloth.shape; }},
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
+    FieldInfo{"material.enabled", "", 0, 0, "whether [material] describes the cloth (any other material field turns it on); false returns to the per-spring form, keeping the mass and spring constants derived on this grid", [](Scene& s) -> FieldRef { return &s.material.enabled; }},
     FieldInfo{"material.preset", "", 0, 0, "a measured fabric (cotton, denim, silk, wool-jersey, polyester) that fills the material fields this scene does not set", [](Scene& s) -> FieldRef { return &s.material.preset; }},
     FieldInfo{"material.density", "kg/m^2", 1e-3, 100, "areal density (mass per area)", [](Scene& s) -> FieldRef { return &s.material.density; }},
     FieldInfo{"material.stretch", "N/m", 1e-2, 1e7, "membrane tensile stiffness (force per width per strain): one number, or [warp along u_axis, weft along v_axis]", [](Scene& s) -> FieldRef { return &s.material.stretch; }},
@@ -221,6 +222,9 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
 
 void validate(const Scene& scene) {
     for (const FieldInfo& f : kFields) {
+        // A field the scene does not hold itself (a per-spring value derived from [material], a preset's value)
+        // is not the user's to range-check: cloth.size = 0.001 derives a mass below cloth.mass's minimum.
+        if (!field_is_written(scene, f.name)) continue;
         auto fail = [&] {
             throw SceneError(std::string(f.name) + " = " + format_value(scene, f) + " is out of range; allowed: " +
                              describe_allowed(f));

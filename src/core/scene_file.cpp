@@ -400,6 +400,15 @@ Scene parse_scene(std::string_view toml_text, std::string_view source_name) {
     }
     Scene scene;
     load_table(scene, table, "", source_name);
+    // A file is not read in order: material.enabled = false beside another material field says two things.
+    if (const toml::table* m = table["material"].as_table(); m && (*m)["enabled"].value_or(true) == false) {
+        for (auto&& [key, node] : *m) {
+            if (key.str() == "enabled") continue;
+            throw SceneError(where(source_name, node) + ": material.enabled = false and material." +
+                             std::string(key.str()) + " both set; allowed: either [material] with enabled = true " +
+                             "(or without enabled), or enabled = false alone");
+        }
+    }
     try {
         validate(scene);
         derive_springs(scene);

@@ -349,6 +349,45 @@ TEST_CASE("material: a scene that sets both forms is refused with the fields tha
     CHECK_NOTHROW(parse_scene("[springs]\ndamping = 1.0\nstrain_limit = 0.1\n[material]\npreset = \"silk\"\n", "e.toml"));
 }
 
+TEST_CASE("material: material.enabled = false returns a material scene to the per-spring form it derived",
+          "[material]") {
+    Scene s = load_scene("hanging");  // cotton, its stretch set
+    REQUIRE(s.material.enabled);
+    const SpringSettings derived = s.settings.springs;
+    const float mass = s.cloth.mass;
+    CHECK_THROWS_WITH(apply_override(s, "springs.structural=500"), Catch::Contains("material.stretch"));
+    apply_override(s, "material.enabled=false");
+    CHECK_FALSE(s.material.enabled);
+    CHECK(s.material.preset.empty());
+    CHECK(s.material.explicit_fields == 0);
+    CHECK(s.settings.springs == derived);  // the same constants and mass, now per spring
+    CHECK(s.cloth.mass == mass);
+    apply_override(s, "springs.structural=500");
+    CHECK(s.settings.springs.structural == glm::vec2(500.0f));
+    const std::string text = to_toml(s);
+    CHECK(text.find("[material]") == std::string::npos);
+    CHECK(parse_scene(text, "back.toml").settings.springs == s.settings.springs);
+    // On again: the material's fields as they stand, unless the scene now sets per-spring fields itself.
+    CHECK_THROWS_WITH(apply_override(s, "material.enabled=true"), Catch::Contains("springs.structural"));
+    // A file is not read in order: enabled = false beside another material field is refused, naming both.
+    CHECK_THROWS_WITH(parse_scene("[material]\nenabled = false\npreset = \"denim\"\n", "f.toml"),
+                      Catch::Contains("f.toml:3") && Catch::Contains("material.enabled = false") &&
+                          Catch::Contains("material.preset"));
+    CHECK_FALSE(parse_scene("[material]\nenabled = false\n", "g.toml").material.enabled);
+    CHECK(parse_scene("[material]\nenabled = true\n", "h.toml").material.enabled);
+}
+
+TEST_CASE("material: derived per-spring values are not range-checked as if the user typed them", "[material]") {
+    // A 1 mm cotton square weighs 1.2e-7 kg, below cloth.mass's minimum of 1e-6 kg: the mass is derived, the
+    // size is in range, so the scene is accepted.
+    Scene s = load_scene("hanging");
+    apply_override(s, "cloth.size=0.001");
+    CHECK(s.cloth.mass == Approx(s.material.density * 1e-6).epsilon(1e-3));
+    CHECK(build_simulation(s).all_finite());
+    // A value the user sets is still checked.
+    CHECK_THROWS_WITH(apply_override(s, "material.density=1e9"), Catch::Contains("material.density"));
+}
+
 TEST_CASE("material: a scene written out reads back the same, with the derived per-spring values as comments",
           "[material]") {
     const Scene s = parse_scene("[cloth]\nrows = 12\ncols = 12\n[material]\npreset = \"wool-jersey\"\nshear = 20\n", "t.toml");

@@ -3,7 +3,7 @@
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind, penalty contact, the user's grab), integrate (gravity and damping inside),
-// collide (the projection contact: sphere, cube, cylinder, ground), limit strain and speed, and once per step see whether
+// collide (the projection contact: sphere, cube, cylinder, ground), pull tethered particles back to their pins, limit strain and speed, and once per step see whether
 // the cloth may sleep. colliders.contact picks penalty contact (a force) or projection (a stage after). Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
 // Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,
@@ -26,6 +26,7 @@
 #include "clothsim/step_plan.hpp"
 #include "clothsim/step_profile.hpp"
 #include "clothsim/colliders.hpp"
+#include "clothsim/tethers.hpp"
 
 #include <glm/vec3.hpp>
 
@@ -97,6 +98,10 @@ public:
     // runs position Verlet), and with how many threads the current settings step.
     bool fast_solver_available() const { return fast_.solver != nullptr; }
     int solver_threads() const;
+    // Tethers to the pins (tethers.hpp; they act when springs.tether_strain > 0), and how many were at their
+    // limit in the last substep.
+    std::size_t tether_count() const { return tethers_.size(); }
+    std::size_t tethers_at_limit() const { return tethers_at_limit_; }
     // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
     int last_solver_iterations() const { return last_iterations_; }
     // The fast solver's kernels on this CPU (chosen at run time): "avx512", "avx2+fma" or "generic".
@@ -187,6 +192,9 @@ private:
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
+    DVec3Array rest_position_;   // m: the positions the cloth was built with (flat, at rest)
+    Tethers tethers_;            // to the current pins, rebuilt when a pin is set or freed
+    std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
     bool asleep_ = false;
     double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed

@@ -89,6 +89,9 @@ struct SpringSettings {
     glm::vec2 bending{10.0f, 10.0f};
     float damping = 0.2f;       // 1/s: velocity damping rate c in x'' = a - c x'
     float strain_limit = 0.0f;  // fraction: 0 = off; otherwise no spring ends a substep longer than (1 + it) L0
+    // fraction: 0 = off; otherwise each free particle stays within (1 + it) x its rest distance of the pins it
+    // hangs from (tethers.hpp)
+    float tether_strain = 0.0f;
     bool operator==(const SpringSettings&) const = default;
 };
 

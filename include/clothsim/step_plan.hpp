@@ -33,6 +33,7 @@ struct StepPlan {
     bool wind = false;
     bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)
     bool sphere = false, cube = false, cylinder = false, ground = false;  // the projection stages (projection contact)
+    bool tethers = false;  // springs.tether_strain > 0 and the cloth has pins to tie to
     bool strain_limit = false;
     bool speed_limit = false;
     bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth
@@ -44,7 +45,8 @@ struct StepPlan {
 };
 
 // `fast_solver` says whether the fast solver can run this topology.
-StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver);
+// `tethers` says whether the cloth has any (it has pins).
+StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver, bool tethers = false);
 
 // Whether the wind stage exerts any force: air moving, or the uniform model's drag on a moving cloth.
 bool wind_active(const ForceSettings& forces);

@@ -23,6 +23,7 @@ enum class Stage {
     Cube,        // cube collisions
     Cylinder,    // cylinder collisions
     Ground,      // ground collisions
+    Tethers,     // long-range attachments to the pins (tethers.hpp)
     StrainLimit, // Provot's strain limit
     SpeedLimit,  // the max_speed clamp
     Sleep,       // the once-per-step check of whether the cloth may sleep

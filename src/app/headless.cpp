@@ -173,6 +173,8 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"potential_energy", finite_or_null(e.potential())},
         {"total_energy", finite_or_null(e.total())},
         {"max_strain", finite_or_null(max_membrane_strain(sim.topology(), sim.state().position))},
+        {"tethers", sim.tether_count()},
+        {"tethers_at_limit", sim.plan().tethers ? sim.tethers_at_limit() : 0},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
     // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.

@@ -33,6 +33,7 @@ constexpr SliderHint kHints[] = {
     {"forces.drag", 0.0f, 10.0f, true},       {"cloth.mass", 0.001f, 100.0f, true},
     {"integration.dt", 1e-4f, 0.1f, true},    {"colliders.thickness", 0.0f, 0.05f, false},
     {"integration.tolerance", 1e-10f, 1e-2f, true}, {"springs.strain_limit", 0.0f, 1.0f, false},
+    {"springs.tether_strain", 0.0f, 0.1f, false},
     {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
     {"solver.sleep_time", 0.0f, 10.0f, false}, {"colliders.contact_stiffness", 10.0f, 1e6f, true},
     {"material.density", 0.01f, 2.0f, true},  {"material.shear", 0.0f, 1e5f, true},

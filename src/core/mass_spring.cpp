@@ -1,6 +1,7 @@
 #include "clothsim/mass_spring.hpp"
 
 #include "clothsim/colliders.hpp"
+#include "clothsim/tethers.hpp"
 #include "forces.hpp"
 #include "fast_solver.hpp"
 #include "integrators.hpp"
@@ -62,6 +63,8 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
         fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
     }
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
+    rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
+    tethers_ = build_tethers(topology_, state_, rest_position_);
     replan();
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
                                      : std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()),
@@ -125,7 +128,11 @@ void MassSpring::step() {
         } break;
     }
     collide(profile);
-    if (plan_.strain_limit || plan_.speed_limit) {
+    if (plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
+        if (plan_.tethers) {
+            StageTimer timer(profile, Stage::Tethers);
+            tethers_at_limit_ = project_tethers(state_, tethers_, settings_.springs.tether_strain);
+        }
         if (plan_.strain_limit) {
             StageTimer timer(profile, Stage::StrainLimit);
             limit_strain();
@@ -191,7 +198,7 @@ void MassSpring::collide(StepProfile* profile) {
 }
 
 void MassSpring::replan() {
-    plan_ = plan_step(topology_, settings_, fast_.solver != nullptr);
+    plan_ = plan_step(topology_, settings_, fast_.solver != nullptr, !tethers_.empty());
 }
 
 void MassSpring::wake() {
@@ -459,6 +466,9 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
+    tethers_ = build_tethers(topology_, state_, rest_position_);  // the pins the cloth hangs from changed
+    tethers_at_limit_ = 0;
+    replan();
 }
 
 void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {

@@ -17,6 +17,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Cube: return "cube";
         case Stage::Cylinder: return "cylinder";
         case Stage::Ground: return "ground";
+        case Stage::Tethers: return "tethers";
         case Stage::StrainLimit: return "strain limit";
         case Stage::SpeedLimit: return "speed limit";
         case Stage::Sleep: return "sleep check";
@@ -42,7 +43,7 @@ bool wind_active(const ForceSettings& forces) {
     return forces.wind != glm::vec3(0.0f) || forces.wind_model == WindModel::Uniform;
 }
 
-StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver) {
+StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver, bool tethers) {
     StepPlan plan;
     if (settings.integration.integrator != Integrator::Verlet) {
         plan.path = StepPath::VelocityIntegrator;
@@ -67,6 +68,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
         plan.cylinder = c.cylinder.enabled;
         plan.ground = c.ground.enabled;
     }
+    plan.tethers = settings.springs.tether_strain > 0.0f && tethers;
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
     plan.speed_limit = settings.forces.max_speed > 0.0f;
     plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
@@ -158,6 +160,8 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     collider(Stage::Cube, plan.cube, c.cube.enabled, "colliders.cube.enabled is false");
     collider(Stage::Cylinder, plan.cylinder, c.cylinder.enabled, "colliders.cylinder.enabled is false");
     collider(Stage::Ground, plan.ground, c.ground.enabled, "colliders.ground.enabled is false");
+    out.push_back({Stage::Tethers, when(plan.tethers, Skipped),
+                   plan.tethers ? "" : (settings.springs.tether_strain > 0.0f ? "no pins to tie to" : "springs.tether_strain is 0")});
     out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
     out.push_back({Stage::SpeedLimit, when(plan.speed_limit, Skipped), plan.speed_limit ? "" : "forces.max_speed is 0"});
     out.push_back({Stage::Sleep, when(plan.may_sleep, Skipped),

@@ -1,0 +1,180 @@
+// Tethers (tethers.hpp): long-range attachments from each free particle to the pins it hangs from.
+#include "support.hpp"
+
+#include "clothsim/scene.hpp"
+#include "clothsim/strain.hpp"
+#include "clothsim/tethers.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+using namespace clothsim;
+
+namespace {
+
+// The largest distance of a tethered particle from its anchor, as a fraction of its rest distance, minus 1.
+double worst_tether_strain(const MassSpring& sim, const Tethers& tethers) {
+    double worst = -1.0;
+    for (std::size_t t = 0; t < tethers.size(); ++t) {
+        const double d = glm::length(sim.state().position.get(tethers.particle[t]) -
+                                     sim.state().position.get(tethers.anchor[t]));
+        worst = std::max(worst, d / tethers.rest[t] - 1.0);
+    }
+    return worst;
+}
+
+// The largest strain of a spring with one end pinned.
+double strain_at_pins(const MassSpring& sim) {
+    double worst = 0.0;
+    for (const Spring& s : sim.topology().springs) {
+        if ((sim.state().pinned[s.a] == kPinned) == (sim.state().pinned[s.b] == kPinned)) continue;
+        const double d = glm::length(sim.state().position.get(s.b) - sim.state().position.get(s.a));
+        worst = std::max(worst, d / s.rest_length - 1.0);
+    }
+    return worst;
+}
+
+Scene hanging(int n, float tether_strain) {
+    Scene s = load_scene("hanging");  // cotton, stretch 1200 N/m, held by two point pins
+    apply_override(s, "cloth.rows=" + std::to_string(n));
+    apply_override(s, "cloth.cols=" + std::to_string(n));
+    s.settings.springs.tether_strain = tether_strain;
+    s.settings.solver.threads = 1;
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("tethers: each free particle is tied to the nearest pin of each pin cluster", "[tethers]") {
+    Scene s = hanging(16, 0.01f);
+    const std::size_t n = 16 * 16;
+    CHECK(build_simulation(s).tether_count() == 2 * (n - 2));  // two corners: two clusters
+    s.pins.preset = PinPreset::FourCorners;
+    CHECK(build_simulation(s).tether_count() == 4 * (n - 4));
+    s.pins.preset = PinPreset::TopRow;
+    const MassSpring row = build_simulation(s);
+    REQUIRE(row.tether_count() == n - 16);  // one pinned row: one cluster
+    // Its nearest pinned particle is the one straight above it (row 0, the same column), at the rest distance.
+    const Tethers tethers = build_tethers(row.topology(), row.state(), row.state().position);
+    for (std::size_t t = 0; t < tethers.size(); ++t) {
+        INFO("tether " << t);
+        REQUIRE(tethers.anchor[t] == tethers.particle[t] % 16);
+        CHECK(tethers.rest[t] == Approx(double(tethers.particle[t] / 16) / 15.0).epsilon(1e-6));
+    }
+    // Clips of 0.15 m at the two corners: each clip's particles are one cluster.
+    s.pins.preset = PinPreset::TopCorners;
+    s.pins.preset_radius = 0.15f;
+    const MassSpring clips = build_simulation(s);
+    std::size_t pinned = 0;
+    for (std::uint8_t p : clips.state().pinned) pinned += p == kPinned;
+    CHECK(pinned > 2);
+    CHECK(clips.tether_count() == 2 * (n - pinned));
+    // No pins, nothing to tie to: the stage is skipped and says why.
+    s.pins = PinSpec{PinPreset::None, {}, 0.0f};
+    const MassSpring loose = build_simulation(s);
+    CHECK(loose.tether_count() == 0);
+    CHECK_FALSE(loose.plan().tethers);
+    bool said = false;
+    for (const StageStatus& st : describe(loose.plan(), loose.topology(), loose.settings())) {
+        if (st.stage == Stage::Tethers) said = st.note == "no pins to tie to";
+    }
+    CHECK(said);
+}
+
+TEST_CASE("tethers: a cloth hanging from two point pins never stretches past tether_strain from them, and the "
+          "springs at the pins stretch no more than that", "[tethers]") {
+    MassSpring free = build_simulation(hanging(32, 0.0f));
+    MassSpring tied = build_simulation(hanging(32, 0.01f));
+    REQUIRE(tied.plan().tethers);
+    const Tethers tethers = build_tethers(tied.topology(), tied.state(), tied.state().position);
+    REQUIRE(tethers.size() == tied.tether_count());
+    double worst = -1.0;
+    for (int step = 0; step < 120; ++step) {  // 2 s: the cloth swings down and hangs
+        free.run_steps(1);
+        tied.run_steps(1);
+        worst = std::max(worst, worst_tether_strain(tied, tethers));
+    }
+    const double untied_pins = strain_at_pins(free), tied_pins = strain_at_pins(tied);
+    INFO("strain at the pins: " << untied_pins << " without tethers, " << tied_pins << " with; worst tether "
+                                << worst << "; max membrane strain " << max_membrane_strain(tied.topology(), tied.state().position)
+                                << " with, " << max_membrane_strain(free.topology(), free.state().position) << " without");
+    CHECK(worst <= 0.01 + 1e-12);  // after every step
+    CHECK(worst > 0.005);          // and they do act: the cloth leans on them
+    CHECK(tied_pins <= 0.01 + 1e-6);  // rest lengths are float: 1.01 L in double differs by ~1e-8
+    CHECK(untied_pins > 0.02);  // the point pins' singular load, which the tethers take
+    CHECK(tied.all_finite());
+}
+
+TEST_CASE("tethers: slack tethers change nothing", "[tethers]") {
+    // Cotton stretches by well under 50% anywhere: tethers that allow 50% are never reached, and the run is
+    // bit-identical to one without them (the stage moves nothing it does not have to).
+    MassSpring free = build_simulation(hanging(16, 0.0f));
+    MassSpring slack = build_simulation(hanging(16, 0.5f));
+    REQUIRE(slack.plan().tethers);
+    free.run_steps(60);
+    slack.run_steps(60);
+    CHECK(slack.tethers_at_limit() == 0);
+    CHECK(test::bit_identical(free, slack));
+}
+
+TEST_CASE("tethers: freeing a pin unties its particles, pinning one ties them to it", "[tethers]") {
+    MassSpring sim = build_simulation(hanging(16, 0.01f));
+    const std::size_t n = 16 * 16;
+    sim.set_pinned(0, false);
+    CHECK(sim.tether_count() == n - 1);
+    sim.run_steps(60);  // the freed corner falls away from where its pin was: nothing holds it there
+    CHECK(glm::length(sim.state().position.get(0) - glm::dvec3(-0.5, 1.6, -0.5)) > 0.3);
+    sim.set_pinned(sim.topology().index(15, 8), true);
+    CHECK(sim.tether_count() == 2 * (n - 2));
+    sim.set_pinned(15, false);
+    sim.set_pinned(sim.topology().index(15, 8), false);
+    CHECK(sim.tether_count() == 0);
+    CHECK_FALSE(sim.plan().tethers);
+}
+
+TEST_CASE("tethers: a tethered pendulum released level swings down with the speed energy allows, never more",
+          "[tethers]") {
+    // Two particles 1 m apart, no spring between them: the pinned one holds the other by a tether alone
+    // (L = 1 m, strain 1%, so a rigid pendulum of 1.01 m once taut). Released level, the free particle
+    // falls straight down until the tether catches it at a drop d with 1 + d^2 = 1.01^2; the catch removes
+    // the radial part of its speed sqrt(2 g d); from there it swings as a pendulum. At the bottom:
+    //   v^2 = v_t^2 + 2 g (1.01 - d),  v_t = sqrt(2 g d) (1 / 1.01)  (the tangential part at the catch).
+    for (const Integrator integrator : {Integrator::Verlet, Integrator::SymplecticEuler}) {
+        Scene s;
+        s.cloth.rows = 1;
+        s.cloth.cols = 2;
+        s.cloth.size = {1.0f, 1.0f};
+        s.cloth.mass = 2.0f;
+        s.cloth.origin = {0.0f, 0.0f, 0.0f};
+        s.pins = PinSpec{PinPreset::None, {PinClip{0, 0, 0.0f}}, 0.0f};
+        s.settings.springs = {glm::vec2(0.0f), 0.0f, glm::vec2(0.0f), 0.0f};
+        s.settings.springs.tether_strain = 0.01f;
+        s.settings.colliders.ground.enabled = false;
+        s.settings.integration.integrator = integrator;
+        s.settings.integration.substeps = 200;
+        MassSpring sim = build_simulation(s);
+        REQUIRE(sim.tether_count() == 1);
+        const double g = 9.81, L = 1.01, d = std::sqrt(L * L - 1.0);
+        const double vt = std::sqrt(2.0 * g * d) / L;
+        const double v_bottom = std::sqrt(vt * vt + 2.0 * g * (L - d));
+        const double v_energy = std::sqrt(2.0 * g * L);  // no loss at all: the bound
+        double lowest = 0.0, speed_at_lowest = 0.0, worst = 0.0;
+        for (int sub = 0; sub < 200 * 40; ++sub) {  // 0.67 s: past the bottom (a quarter swing is 0.5 s)
+            sim.step();
+            const glm::dvec3 x = sim.state().position.get(1);
+            worst = std::max(worst, glm::length(x) - L);
+            if (x.y < lowest) {
+                lowest = x.y;
+                speed_at_lowest = glm::length(sim.velocities()[1]);
+            }
+        }
+        INFO(integrator_names()[static_cast<int>(integrator)] << ": lowest " << lowest << " m at " << speed_at_lowest << " m/s; analytic "
+                                         << v_bottom << " m/s (bound " << v_energy << ")");
+        CHECK(worst <= 1e-12);
+        CHECK(lowest == Approx(-L).epsilon(1e-4));
+        CHECK(speed_at_lowest == Approx(v_bottom).epsilon(0.01));
+        CHECK(speed_at_lowest <= v_energy);
+    }
+}

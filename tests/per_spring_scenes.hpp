@@ -17,7 +17,7 @@
 
 namespace clothsim {
 
-// What each bundled file held before the move (springs.damping stayed in the files and is not repeated).
+// What each bundled file held before the move.
 struct PerSpringForm {
     std::string_view scene;
     float mass;        // kg, the whole cloth
@@ -25,14 +25,15 @@ struct PerSpringForm {
     float shear;       // N/m
     float bending;     // N/m, each skip-one spring (both axes)
     int substeps;      // per step: 0.67 to 0.68 of the critical substep
+    float damping;     // 1/s
 };
 inline constexpr std::array<PerSpringForm, 6> kPerSpringForms = {{
-    {"hanging", 0.5f, 400.0f, 40.0f, 10.0f, 34},
-    {"drape-sphere", 0.6f, 400.0f, 40.0f, 5.0f, 38},
-    {"drape-cube", 0.6f, 400.0f, 40.0f, 5.0f, 38},
-    {"falling", 0.5f, 400.0f, 40.0f, 10.0f, 34},
-    {"flag", 0.3f, 400.0f, 40.0f, 8.0f, 40},
-    {"curtain", 0.8f, 400.0f, 40.0f, 4.0f, 36},
+    {"hanging", 0.5f, 400.0f, 40.0f, 10.0f, 34, 0.2f},
+    {"drape-sphere", 0.6f, 400.0f, 40.0f, 5.0f, 38, 0.3f},
+    {"drape-cube", 0.6f, 400.0f, 40.0f, 5.0f, 38, 0.3f},
+    {"falling", 0.5f, 400.0f, 40.0f, 10.0f, 34, 0.3f},
+    {"flag", 0.3f, 400.0f, 40.0f, 8.0f, 40, 0.1f},
+    {"curtain", 0.8f, 400.0f, 40.0f, 4.0f, 36, 0.3f},
 }};
 
 inline const PerSpringForm* find_per_spring_form(std::string_view scene) {
@@ -58,6 +59,7 @@ inline Scene per_spring_scene(std::string_view name) {
     s.settings.springs.shear = form->shear;
     s.settings.springs.bending = glm::vec2(form->bending);
     s.settings.integration.substeps = form->substeps;
+    s.settings.springs.damping = form->damping;
     return s;
 }
 

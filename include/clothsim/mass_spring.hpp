@@ -102,8 +102,10 @@ public:
     // limit in the last substep.
     std::size_t tether_count() const { return tethers_.size(); }
     std::size_t tethers_at_limit() const { return tethers_at_limit_; }
-    // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators).
+    // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators), and the
+    // relative residual |b - A dv| / |b| the solve stopped at.
     int last_solver_iterations() const { return last_iterations_; }
+    double last_solver_residual() const { return last_residual_; }
     // The fast solver's kernels on this CPU (chosen at run time): "avx512", "avx2+fma" or "generic".
     static const char* fast_kernel_name();
 
@@ -196,6 +198,7 @@ private:
     Tethers tethers_;            // to the current pins, rebuilt when a pin is set or freed
     std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
+    double last_residual_ = 0.0;
     bool asleep_ = false;
     double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
     DVec3Array sleep_reference_;  // m: positions at the last sleep check (empty: none since waking)

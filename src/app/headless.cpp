@@ -177,6 +177,18 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"tethers_at_limit", sim.plan().tethers ? sim.tethers_at_limit() : 0},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
+    // Which solver ran and, for an iterative one, how far its last solve got.
+    const Integrator integrator = sim.settings().integration.integrator;
+    nlohmann::json solver = {
+        {"integrator", integrator_names()[static_cast<int>(integrator)]},
+        {"path", sim.plan().path == StepPath::Fast ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
+        {"threads", sim.solver_threads()},
+    };
+    if (integrator == Integrator::ImplicitEuler) {
+        solver["iterations"] = sim.last_solver_iterations();  // CG, last substep
+        solver["residual"] = finite_or_null(sim.last_solver_residual());  // |b - A dv| / |b|
+    }
+    out["solver"] = solver;
     // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.
     const CylinderCollider& support = sim.settings().colliders.cylinder;
     if (scene.cloth.shape == ClothShape::Disc && support.enabled) {

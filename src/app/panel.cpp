@@ -581,7 +581,13 @@ void stats_section(const AppState& app) {
     const Integrator integrator = app.sim.settings().integration.integrator;
     ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
                 integrator == Integrator::ImplicitEuler
-                    ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations").c_str()
+                    ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations, residual " +
+                       [&] {
+                           char text[32];
+                           std::snprintf(text, sizeof text, "%.2g", app.sim.last_solver_residual());
+                           return std::string(text);
+                       }())
+                          .c_str()
                     : "");
     if (app.stats.total.size() > 1) {
         const History& e = app.stats.total;

@@ -56,7 +56,7 @@ double dot(const Vec3Array& a, const Vec3Array& b) {
 
 }  // namespace
 
-int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
+LinearSolve step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
                         const SpringSettings& springs, float tolerance, double substep) {
     const std::size_t n = state.size();
     const float c = dynamics.damping;
@@ -122,7 +122,7 @@ int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& 
         state.motion.set(i, moved);
         state.position.add(i, moved);
     }
-    return iterations;
+    return {iterations, b_norm2 > 0.0 ? std::sqrt(r2 / b_norm2) : 0.0};
 }
 
 }  // namespace clothsim

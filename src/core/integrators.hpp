@@ -44,9 +44,14 @@ void step_rk4(State& state, const BasicDynamics<F>& dynamics, double h);
 //   ((1 + h c) M - h^2 K) dv = h (F + M g - c M v + h K v),   v' = v + dv,   x' = x + h v'
 // with K the spring Jacobian, its transverse part clamped for compressed springs so the matrix stays
 // symmetric positive definite, solved by conjugate gradients to `tolerance` (relative residual). Pinned
-// particles are held by filtering their rows out of the solve. Returns the CG iterations used.
+// particles are held by filtering their rows out of the solve. Returns the CG iterations used and the
+// relative residual |b - A dv| / |b| it stopped at (0 when b = 0).
 // The linear solve is in float (it finds the velocity change); the state update adds it in double.
-int step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
+struct LinearSolve {
+    int iterations = 0;
+    double residual = 0.0;
+};
+LinearSolve step_implicit_euler(State& state, const Dynamics& dynamics, const Topology& topology,
                         const SpringSettings& springs, float tolerance, double h);
 
 // XPBD (Macklin et al. 2016) with one constraint iteration per substep ("Small Steps", Macklin et al.

@@ -299,9 +299,12 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
         case Integrator::SymplecticEuler: step_symplectic_euler(state_, dynamics, h); break;
         case Integrator::Rk4: step_rk4(state_, dynamics, h); break;
         case Integrator::ImplicitEuler:
-            last_iterations_ = step_implicit_euler(state_, dynamics, topology_, settings_.springs,
-                                                   settings_.integration.tolerance, h);
-            break;
+        {
+            const LinearSolve solve = step_implicit_euler(state_, dynamics, topology_, settings_.springs,
+                                                          settings_.integration.tolerance, h);
+            last_iterations_ = solve.iterations;
+            last_residual_ = solve.residual;
+        } break;
         case Integrator::Xpbd: step_xpbd(state_, dynamics, topology_, settings_.springs, h); break;
         case Integrator::Verlet: break;  // handled by step()
     }

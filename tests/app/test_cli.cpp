@@ -84,6 +84,29 @@ void expect_bad_input(const std::vector<std::string>& args, std::initializer_lis
 // --json
 // ---------------------------------------------------------------------------------------------------------
 
+TEST_CASE("cli: --json says which solver ran and, for implicit Euler, its CG iterations and the residual it reached") {
+    const RunResult fast = run_clothsim({"--headless", "--steps", "2", "--set", "solver.threads=1", "--json"});
+    CAPTURE_RUN(fast);
+    REQUIRE(fast.code == 0);
+    const nlohmann::json verlet = nlohmann::json::parse(fast.out).at("solver");
+    CHECK(verlet.at("integrator") == "verlet");
+    CHECK(verlet.at("path") == "fast");
+    CHECK(verlet.at("threads") == 1);
+    CHECK_FALSE(verlet.contains("iterations"));
+    const RunResult r = run_clothsim({"--headless", "--steps", "2", "--set", "cloth.rows=12", "--set", "cloth.cols=12",
+                                      "--set", "integration.integrator=implicit-euler", "--set",
+                                      "integration.substeps=2", "--set", "integration.tolerance=1e-4", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const nlohmann::json implicit = nlohmann::json::parse(r.out).at("solver");
+    CHECK(implicit.at("integrator") == "implicit-euler");
+    CHECK(implicit.at("path") == "velocity integrator");
+    CHECK(implicit.at("iterations").get<int>() > 0);
+    // CG stops once the relative residual is under the tolerance (or at its iteration cap, far away here).
+    CHECK(implicit.at("residual").get<double>() <= 1e-4);
+    CHECK(implicit.at("residual").get<double>() >= 0.0);
+}
+
 TEST_CASE("cli: --headless --json prints only a JSON report on stdout") {
     const RunResult r = run_clothsim({"--headless", "--scene", "drape-sphere", "--duration", "3", "--json"});
     CAPTURE_RUN(r);

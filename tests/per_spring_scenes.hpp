@@ -60,6 +60,7 @@ inline Scene per_spring_scene(std::string_view name) {
     s.settings.springs.bending = glm::vec2(form->bending);
     s.settings.integration.substeps = form->substeps;
     s.settings.springs.damping = form->damping;
+    s.settings.springs.tether_strain = 0.0f;  // no file had tethers then
     return s;
 }
 

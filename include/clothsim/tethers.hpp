@@ -27,7 +27,7 @@ namespace clothsim {
 
 inline constexpr int kMaxTethersPerParticle = 4;
 
-// Structure of arrays, grouped by particle in index order.
+// Structure of arrays, grouped by particle in index order, each particle's farthest pin first.
 struct Tethers {
     std::vector<std::uint32_t> particle;  // the free particle
     std::vector<std::uint32_t> anchor;    // the pinned particle it is tied to

@@ -58,6 +58,10 @@ Tethers build_tethers(const Topology& topology, const State& state, const DVec3A
         }
         const std::size_t kept = std::min<std::size_t>(cluster_count, kMaxTethersPerParticle);
         std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(kept), nearest.end());
+        // Farthest first: when pins moved apart ask for more than the cloth can give (a pin dragged away from
+        // the others), the nearest pin's tether is projected last and wins, so the cloth next to a dragged
+        // pin follows it.
+        std::reverse(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(kept));
         for (std::size_t c = 0; c < kept; ++c) {
             out.particle.push_back(i);
             out.anchor.push_back(nearest[c].second);

@@ -5,6 +5,7 @@
 #include "textbook_aos.hpp"
 #include "skipping.hpp"
 #include "stability_sweep.hpp"
+#include "stiff_precision.hpp"
 #include "substep_sweep.hpp"
 #include "work_precision.hpp"
 
@@ -109,6 +110,27 @@ int main(int argc, char** argv) {
     work_precision->add_option("--repeats", wp.repeats, "Timed repetitions (median)")->check(CLI::Range(1, 50));
     work_precision->add_option("--csv", wp.csv, "Write the sweep as CSV");
     work_precision->add_option("--plots", wp.plot_dir, "Write accuracy-SCENE.png here (needs --csv; gnuplot)");
+    bench::StiffPrecisionOptions sp;
+    CLI::App* stiff_precision = app.add_subcommand(
+        "stiff-precision",
+        "Run time against error on stiff-hanging (cotton at its measured stretch) for every integrator, one thread "
+        "(docs/ACCURACY.md)");
+    stiff_precision->add_option("--sizes", sp.sizes, "Particles per side")->delimiter(',')->check(CLI::Range(2, 1024));
+    stiff_precision->add_option("--integrators", sp.integrators, "Integrators to sweep")->delimiter(',');
+    stiff_precision->add_option("--repeats", sp.repeats, "Timed repetitions (median)")->check(CLI::Range(1, 50));
+    stiff_precision->add_option("--reference-factor", sp.reference_factor,
+                                "The reference: Verlet at this many times the stable substeps")
+        ->check(CLI::Range(4, 64));
+    stiff_precision->add_option("--max-substeps", sp.max_substeps, "implicit-euler and xpbd: 1, 2, 4, ... up to this")
+        ->check(CLI::Range(1, kMaxSubsteps));
+    stiff_precision->add_option("--max-run-seconds", sp.max_run_seconds,
+                                "Skip a setting whose first step predicts more CPU seconds per simulated second")
+        ->check(CLI::PositiveNumber);
+    stiff_precision->add_option("--max-sweep-seconds", sp.max_sweep_seconds,
+                                "Stop an integrator's sweep at one size once its runs took this long")
+        ->check(CLI::PositiveNumber);
+    stiff_precision->add_option("--csv", sp.csv, "Write the sweep as CSV");
+    stiff_precision->add_option("--plots", sp.plot_dir, "Write stiff-precision-SIZE.png here (needs --csv; gnuplot)");
     bench::SubstepSweepOptions ss;
     CLI::App* substep_sweep = app.add_subcommand(
         "substep-sweep", "Error against substeps per 1/60 s step for every integrator (docs/ACCURACY.md)");
@@ -140,6 +162,7 @@ int main(int argc, char** argv) {
         return app.exit(e) == 0 ? 0 : 2;
     }
     if (*work_precision) return bench::run_work_precision(wp);
+    if (*stiff_precision) return bench::run_stiff_precision(sp);
     if (*stability) return bench::run_stability(st);
     if (*substep_sweep) return bench::run_substep_sweep(ss);
     if (*skipping) return bench::run_skipping(sk);

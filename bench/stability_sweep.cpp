@@ -1,6 +1,7 @@
 #include "stability_sweep.hpp"
 
 #include "csv.hpp"
+#include "plot.hpp"
 
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
@@ -122,13 +123,7 @@ int run_stability(const StabilityOptions& options) {
                 verlet_cases - unsafe, verlet_cases, verlet_cases - beyond_two, verlet_cases);
     if (csv) csv.close();
     if (!options.plot.empty() && !options.csv.empty()) {
-        const std::string command = "gnuplot -e \"csv='" + options.csv + "'; png='" + options.plot + "'\" " +
-                                    CLOTHSIM_BENCH_DIR "/plot_stability.gnuplot";
-        if (std::system(command.c_str()) != 0) {
-            std::cerr << "clothsim-bench: error: gnuplot failed for " << options.plot << "\n";
-            return 2;
-        }
-        std::printf("wrote %s\n", options.plot.c_str());
+        if (!plot("plot_stability.gnuplot", {{"csv", options.csv}}, options.plot)) return 2;
     }
     return 0;
 }

@@ -1,6 +1,7 @@
 #include "stiff_precision.hpp"
 
 #include "csv.hpp"
+#include "plot.hpp"
 
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
@@ -346,13 +347,9 @@ int run_stiff_precision(const StiffPrecisionOptions& options) {
     if (!options.plot_dir.empty() && !options.csv.empty()) {
         for (int side : options.sizes) {
             const std::string png = options.plot_dir + "/stiff-precision-" + std::to_string(side) + ".png";
-            const std::string command = "gnuplot -e \"csv='" + options.csv + "'; size='" + std::to_string(side) +
-                                        "'; png='" + png + "'\" " CLOTHSIM_BENCH_DIR "/plot_stiff_precision.gnuplot";
-            if (std::system(command.c_str()) != 0) {
-                std::cerr << "clothsim-bench: error: gnuplot failed for " << png << "\n";
+            if (!plot("plot_stiff_precision.gnuplot", {{"csv", options.csv}, {"size", std::to_string(side)}}, png)) {
                 return 2;
             }
-            std::printf("wrote %s\n", png.c_str());
         }
     }
     return 0;

@@ -1,6 +1,7 @@
 #include "substep_sweep.hpp"
 
 #include "csv.hpp"
+#include "plot.hpp"
 
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
@@ -270,14 +271,10 @@ int run_substep_sweep(const SubstepSweepOptions& options) {
         for (const Sweep& sweep : sweeps) durations += (durations.empty() ? "" : " ") + sweep.label;
         for (const std::string& name : options.integrators) integrators += (integrators.empty() ? "" : " ") + name;
         const std::string png = options.plot_dir + "/accuracy-substeps.png";
-        const std::string command = "gnuplot -e \"csv='" + options.csv + "'; durations='" + durations +
-                                    "'; integrators='" + integrators + "'; png='" + png + "'\" " +
-                                    CLOTHSIM_BENCH_DIR "/plot_substep_sweep.gnuplot";
-        if (std::system(command.c_str()) != 0) {
-            std::cerr << "clothsim-bench: error: gnuplot failed for " << png << "\n";
+        if (!plot("plot_substep_sweep.gnuplot",
+                  {{"csv", options.csv}, {"durations", durations}, {"integrators", integrators}}, png, "\n")) {
             return 2;
         }
-        std::printf("\nwrote %s\n", png.c_str());
     }
     return 0;
 }

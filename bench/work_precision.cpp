@@ -1,6 +1,7 @@
 #include "work_precision.hpp"
 
 #include "csv.hpp"
+#include "plot.hpp"
 
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
@@ -158,13 +159,7 @@ int run_work_precision(const WorkPrecisionOptions& options) {
     if (!options.plot_dir.empty() && !options.csv.empty()) {
         for (const std::string& scene_name : options.scenes) {
             const std::string png = options.plot_dir + "/accuracy-" + scene_name + ".png";
-            const std::string command = "gnuplot -e \"csv='" + options.csv + "'; scene='" + scene_name + "'; png='" +
-                                        png + "'\" " + CLOTHSIM_BENCH_DIR "/plot_work_precision.gnuplot";
-            if (std::system(command.c_str()) != 0) {
-                std::cerr << "clothsim-bench: error: gnuplot failed for " << png << "\n";
-                return 2;
-            }
-            std::printf("wrote %s\n", png.c_str());
+            if (!plot("plot_work_precision.gnuplot", {{"csv", options.csv}, {"scene", scene_name}}, png)) return 2;
         }
     }
     return 0;

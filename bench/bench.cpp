@@ -121,6 +121,8 @@ int main(int argc, char** argv) {
     stiff_precision->add_option("--reference-factor", sp.reference_factor,
                                 "The reference: Verlet at this many times the stable substeps")
         ->check(CLI::Range(4, 64));
+    stiff_precision->add_option("--set", sp.overrides,
+                                "KEY=VALUE scene field for every integrator but Verlet (e.g. integration.iterations=30)");
     stiff_precision->add_option("--max-substeps", sp.max_substeps, "implicit-euler and xpbd: 1, 2, 4, ... up to this")
         ->check(CLI::Range(1, kMaxSubsteps));
     stiff_precision->add_option("--max-run-seconds", sp.max_run_seconds,

@@ -46,11 +46,17 @@ bool is_explicit(const std::string& integrator) {
 }
 
 // stiff-hanging on a side x side grid: a material scene, so every size is the same cotton.
+// The --set overrides apply to the integrators that are not the reference's (Verlet).
+std::vector<std::string> overrides;
+
 Scene stiff_scene(int side, const std::string& integrator, int substeps) {
     Scene s = load_scene("stiff-hanging");
     s.cloth.rows = s.cloth.cols = side;
     s.settings.solver.threads = 1;
     apply_override(s, "integration.integrator=" + integrator);
+    if (integrator != "verlet") {
+        for (const std::string& o : overrides) apply_override(s, o);
+    }
     s.settings.integration.substeps = substeps;
     return s;
 }
@@ -170,6 +176,7 @@ Row measure(int side, const std::string& integrator, int substeps, double critic
 }  // namespace
 
 int run_stiff_precision(const StiffPrecisionOptions& options) {
+    overrides = options.overrides;
     std::ofstream csv;
     if (!open_csv(options.csv,
                   "size,integrator,substeps,stable_substeps,substep_over_critical,status,repeats,"

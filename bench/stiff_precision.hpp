@@ -16,12 +16,13 @@ namespace clothsim::bench {
 
 struct StiffPrecisionOptions {
     std::vector<int> sizes{32, 64, 128};  // particles per side
-    std::vector<std::string> integrators{"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd"};
+    std::vector<std::string> integrators{"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd", "projective"};
     int repeats = 3;                  // timed repetitions of each setting (median)
     int reference_factor = 8;         // the reference's substeps: this times the stable count
-    int max_substeps = 4096;          // implicit-euler and xpbd run 1, 2, 4, ... up to this
+    int max_substeps = 4096;          // implicit-euler, xpbd and projective run 1, 2, 4, ... up to this
     double max_run_seconds = 45.0;    // skip a setting whose first step predicts more CPU s per simulated second
     double max_sweep_seconds = 120.0; // stop an integrator's sweep at one size once its runs took this long
+    std::vector<std::string> overrides; // --set KEY=VALUE for every integrator but Verlet (its reference)
     std::string csv;                  // output CSV
     std::string plot_dir;             // where to write stiff-precision-SIZE.png (gnuplot); empty for none
 };

@@ -102,10 +102,11 @@ public:
     // limit in the last substep.
     std::size_t tether_count() const { return tethers_.size(); }
     std::size_t tethers_at_limit() const { return tethers_at_limit_; }
-    // Conjugate-gradient iterations of the last implicit-Euler substep (0 for the other integrators), and the
-    // relative residual |b - A dv| / |b| the solve stopped at.
+    // How far the last substep's solve got (0 for the explicit integrators): implicit Euler's CG iterations and
+    // |b - A dv| / |b|; projective's quasi-Newton iterations and relative force imbalance (projective.hpp);
+    // XPBD's one iteration and its constraint residual |C + alpha~ lambda| / |C| at the current positions.
     int last_solver_iterations() const { return last_iterations_; }
-    double last_solver_residual() const { return last_residual_; }
+    double last_solver_residual() const;
     // The fast solver's kernels on this CPU (chosen at run time): "avx512", "avx2+fma" or "generic".
     static const char* fast_kernel_name();
 
@@ -164,7 +165,8 @@ private:
     // The stages of step(), in pipeline order.
     void step_fast(double h, StepProfile* profile);
     void step_textbook(double h, StepProfile* profile);
-    void step_velocity_integrator(Integrator integrator, double h);
+    // `continues`: the state is what the previous substep left (a multistep integrator may use its history).
+    void step_velocity_integrator(Integrator integrator, double h, bool continues);
     void collide(StepProfile* profile);
     void limit_strain();
     void limit_speed(double h);
@@ -183,10 +185,27 @@ private:
         ~FastSolverHolder();
     };
 
+    // What the iterative integrators keep between substeps (internal to src/core, so held by pointer): the
+    // projective solver's factorised matrix and BDF2 history (projective.hpp), XPBD's multipliers
+    // (integrators.hpp). Copies of the simulation copy it.
+    struct IterativeSolvers {
+        struct Data;
+        std::unique_ptr<Data> data;
+        IterativeSolvers();
+        IterativeSolvers(const IterativeSolvers& other);
+        IterativeSolvers& operator=(const IterativeSolvers& other);
+        IterativeSolvers(IterativeSolvers&&) noexcept;
+        IterativeSolvers& operator=(IterativeSolvers&&) noexcept;
+        ~IterativeSolvers();
+        void invalidate_matrix();  // the projective matrix's inputs changed: factorise again at the next step
+    };
+
     Topology topology_;
     State state_;
     SimulationSettings settings_;
     FastSolverHolder fast_;      // the fast solver, when the topology is a grid
+    IterativeSolvers iterative_;
+    std::uint64_t history_stamp_ = 0;  // stamp_ as the last substep left it; 0 after a restart
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;

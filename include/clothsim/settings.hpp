@@ -17,13 +17,15 @@ namespace clothsim {
 // Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
 
-// The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd).
+// The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,
+// projective).
 enum class Integrator {
     Verlet,           // position Verlet with physical damping: second order, symplectic (the default)
     SymplecticEuler,  // semi-implicit Euler: v += h a, x += h v; first order, symplectic
     Rk4,              // classical Runge-Kutta: fourth order, explicit
     ImplicitEuler,    // backward Euler linearised once per step, CG on the spring Jacobian (Baraff-Witkin 1998)
     Xpbd,             // extended position-based dynamics, one iteration per substep, compliance 1/k
+    Projective,       // BDF2 solved by projective dynamics on a prefactorised matrix: the stiff-cloth solver
 };
 
 // The outline of the cloth on its grid.
@@ -175,7 +177,8 @@ struct IntegrationSettings {
     float dt = 1.0f / 60.0f;  // s: one step (one frame of the app)
     int substeps = 34;        // integration substeps per step; each advances dt / substeps
     Integrator integrator = Integrator::Verlet;
-    float tolerance = 1e-5f;  // implicit Euler: CG stops at this residual relative to the right-hand side
+    float tolerance = 1e-5f;  // implicit Euler, projective: the solve stops at this relative residual
+    int iterations = 10;      // projective: the most local-global iterations per substep
     bool operator==(const IntegrationSettings&) const = default;
 };
 

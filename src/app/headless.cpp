@@ -184,9 +184,12 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"path", sim.plan().path == StepPath::Fast ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
         {"threads", sim.solver_threads()},
     };
-    if (integrator == Integrator::ImplicitEuler) {
-        solver["iterations"] = sim.last_solver_iterations();  // CG, last substep
-        solver["residual"] = finite_or_null(sim.last_solver_residual());  // |b - A dv| / |b|
+    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
+        integrator == Integrator::Xpbd) {
+        // Last substep (MassSpring::last_solver_residual): CG (implicit-euler), quasi-Newton (projective) or
+        // constraint (xpbd) iterations and relative residual.
+        solver["iterations"] = sim.last_solver_iterations();
+        solver["residual"] = finite_or_null(sim.last_solver_residual());
     }
     out["solver"] = solver;
     // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.

@@ -580,8 +580,10 @@ void stats_section(const AppState& app) {
     // contact it should stay put, and its drift measures the integrator's error at this step.
     const Integrator integrator = app.sim.settings().integration.integrator;
     ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
-                integrator == Integrator::ImplicitEuler
-                    ? (", CG " + std::to_string(app.sim.last_solver_iterations()) + " iterations, residual " +
+                integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
+                        integrator == Integrator::Xpbd
+                    ? ((integrator == Integrator::ImplicitEuler ? ", CG " : ", ") +
+                       std::to_string(app.sim.last_solver_iterations()) + " iterations, residual " +
                        [&] {
                            char text[32];
                            std::snprintf(text, sizeof text, "%.2g", app.sim.last_solver_residual());

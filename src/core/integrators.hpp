@@ -59,7 +59,19 @@ LinearSolve step_implicit_euler(State& state, const Dynamics& dynamics, const To
 // C = |x_b - x_a| - L0 once, in list order, with compliance 1/k; v = (x' - x) / h. Converges to the
 // spring model as the substep shrinks. The projection is computed in double: its corrections are as small
 // as the substep's motion.
+// It records each constraint's multiplier, so that the constraint residual |C(x) + alpha~ lambda|
+// (Macklin, Mueller & Chentanez 2016, eq. 9: zero when the projection has converged; alpha~ = 1/(k h^2)) can
+// be measured at the end of the step, after collisions too, relative to |C| of the prediction.
+struct XpbdMultipliers {
+    std::vector<double> spring;     // per spring
+    std::vector<glm::dvec3> bend;   // per bend (a vector constraint)
+    double substep = 0.0;           // s
+    double initial_violation = 0.0; // |C| at the prediction, over all springs and bends
+};
 void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
-               double h);
+               double h, XpbdMultipliers& multipliers);
+// |C(x) + alpha~ lambda| / |C(prediction)| at `position` for the multipliers of the last substep (0 before one).
+double xpbd_residual(const DVec3Array& position, const Topology& topology, const SpringSettings& springs,
+                     const XpbdMultipliers& multipliers);
 
 }  // namespace clothsim

@@ -6,6 +6,7 @@
 #include "fast_solver.hpp"
 #include "integrators.hpp"
 #include "penalty_contact.hpp"
+#include "projective.hpp"
 #include "verlet.hpp"
 
 #include <glm/common.hpp>
@@ -73,6 +74,24 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     setup_stamp_ = next_stamp();
 }
 
+struct MassSpring::IterativeSolvers::Data {
+    ProjectiveSolver projective;
+    XpbdMultipliers xpbd;
+};
+MassSpring::IterativeSolvers::IterativeSolvers() : data(std::make_unique<Data>()) {}
+MassSpring::IterativeSolvers::IterativeSolvers(const IterativeSolvers& other)
+    : data(std::make_unique<Data>(*other.data)) {}
+MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(const IterativeSolvers& other) {
+    if (this != &other) data = std::make_unique<Data>(*other.data);
+    return *this;
+}
+MassSpring::IterativeSolvers::IterativeSolvers(IterativeSolvers&&) noexcept = default;
+MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(IterativeSolvers&&) noexcept = default;
+MassSpring::IterativeSolvers::~IterativeSolvers() = default;
+void MassSpring::IterativeSolvers::invalidate_matrix() {
+    if (data) data->projective.invalidate_matrix();
+}
+
 MassSpring::~MassSpring() = default;
 MassSpring::MassSpring(const MassSpring&) = default;
 MassSpring& MassSpring::operator=(const MassSpring&) = default;
@@ -93,6 +112,10 @@ double MassSpring::substep_length() const {
 
 void MassSpring::apply(const SimulationSettings& settings) {
     if (settings == settings_) return;
+    // The projective solver's matrix holds the stiffness, the substep and the damping.
+    if (settings.springs != settings_.springs || settings.integration != settings_.integration) {
+        iterative_.invalidate_matrix();
+    }
     settings_ = settings;
     replan();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
@@ -118,13 +141,14 @@ void MassSpring::step() {
     blocks_.current = blocks_.boxes_current = false;  // positions move now: last substep's boxes are stale
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
+    const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
 
     switch (plan_.path) {
         case StepPath::Fast: step_fast(h, profile); break;
         case StepPath::Textbook: step_textbook(h, profile); break;
         case StepPath::VelocityIntegrator: {
             StageTimer timer(profile, Stage::Integrate);
-            step_velocity_integrator(integrator, h);
+            step_velocity_integrator(integrator, h, continues);
         } break;
     }
     collide(profile);
@@ -147,6 +171,7 @@ void MassSpring::step() {
     state_.time += h;
     ++profile_.substeps;
     stamp_ = next_stamp();
+    history_stamp_ = stamp_;
     if (++substeps_since_check_ >= settings_.integration.substeps) {
         substeps_since_check_ = 0;
         if (plan_.may_sleep) {
@@ -284,7 +309,7 @@ void MassSpring::limit_speed(double h) {
 }
 
 // One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.
-void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
+void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool continues) {
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
@@ -305,7 +330,24 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h) {
             last_iterations_ = solve.iterations;
             last_residual_ = solve.residual;
         } break;
-        case Integrator::Xpbd: step_xpbd(state_, dynamics, topology_, settings_.springs, h); break;
+        case Integrator::Xpbd:
+            step_xpbd(state_, dynamics, topology_, settings_.springs, h, iterative_.data->xpbd);
+            last_iterations_ = 1;
+            break;
+        case Integrator::Projective: {
+            // Wind, contact and a grab are held at their value at the start of the substep.
+            external(state_, force_);
+            ProjectiveSolver::Inputs inputs;
+            inputs.external = &force_;
+            inputs.gravity = settings_.forces.gravity;
+            inputs.damping = settings_.springs.damping;
+            inputs.iterations = settings_.integration.iterations;
+            inputs.tolerance = settings_.integration.tolerance;
+            const LinearSolve solve =
+                iterative_.data->projective.step(state_, topology_, settings_.springs, inputs, h, continues);
+            last_iterations_ = solve.iterations;
+            last_residual_ = solve.residual;
+        } break;
         case Integrator::Verlet: break;  // handled by step()
     }
 }
@@ -375,6 +417,15 @@ glm::vec3 MassSpring::grab_force(const State& state) const {
     return glm::vec3(f);
 }
 
+// XPBD's residual is measured when asked, at the positions now (after collisions and limits): the step
+// itself pays nothing for it.
+double MassSpring::last_solver_residual() const {
+    if (settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd) {
+        return xpbd_residual(state_.position, topology_, settings_.springs, iterative_.data->xpbd);
+    }
+    return last_residual_;
+}
+
 void MassSpring::run_steps(long long steps) {
     for (long long s = 0; s < steps; ++s) {
         for (int i = 0; i < settings_.integration.substeps; ++i) step();
@@ -382,6 +433,7 @@ void MassSpring::run_steps(long long steps) {
 }
 
 void MassSpring::restart(const std::vector<glm::dvec3>& velocity, double h) {
+    history_stamp_ = 0;  // the velocities are new: a multistep integrator starts afresh
     const Integrator integrator = settings_.integration.integrator;
     state_.integrator = integrator;
     if (integrator == Integrator::Verlet) {
@@ -469,6 +521,7 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
+    iterative_.invalidate_matrix();  // its matrix is over the free particles
     tethers_ = build_tethers(topology_, state_, rest_position_);  // the pins the cloth hangs from changed
     tethers_at_limit_ = 0;
     replan();

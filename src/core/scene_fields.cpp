@@ -81,8 +81,9 @@ const std::array kFields = {
 
     FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
     FieldInfo{"integration.substeps", "", 1, kMaxSubsteps, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
-    FieldInfo{"integration.integrator", "", 0, 0, "time integrator (orders: verlet 2, symplectic-euler 1, rk4 4, implicit-euler 1; xpbd tends to the spring model as substeps grow)", [](Scene& s) -> FieldRef { return &s.settings.integration.integrator; }},
-    FieldInfo{"integration.tolerance", "", 1e-12, 0.1, "implicit-euler: conjugate-gradient residual relative to the right-hand side", [](Scene& s) -> FieldRef { return &s.settings.integration.tolerance; }},
+    FieldInfo{"integration.integrator", "", 0, 0, "time integrator (orders: verlet 2, symplectic-euler 1, rk4 4, implicit-euler 1, projective 2 (BDF2 by quasi-Newton on a prefactorised matrix; stable at any step); xpbd tends to the spring model as substeps grow)", [](Scene& s) -> FieldRef { return &s.settings.integration.integrator; }},
+    FieldInfo{"integration.tolerance", "", 1e-12, 0.1, "implicit-euler: conjugate-gradient residual relative to the right-hand side; projective: the step's force imbalance |grad g| relative to its start or to the loads, whichever is larger", [](Scene& s) -> FieldRef { return &s.settings.integration.tolerance; }},
+    FieldInfo{"integration.iterations", "", 1, 1000, "projective: the most quasi-Newton iterations per substep (each one solve with the prefactorised matrix)", [](Scene& s) -> FieldRef { return &s.settings.integration.iterations; }},
 
     FieldInfo{"solver.method", "", 0, 0, "fast: vectorised multi-threaded row sweeps; textbook: spring-list loop (the test oracle)", [](Scene& s) -> FieldRef { return &s.settings.solver.method; }},
     FieldInfo{"solver.threads", "", 0, 64, "threads of the fast solver; 0 = one per core; results are identical for any count", [](Scene& s) -> FieldRef { return &s.settings.solver.threads; }},
@@ -96,8 +97,8 @@ constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corner
                                                              "left-edge"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
-constexpr std::array<std::string_view, 5> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
-                                                               "xpbd"};
+constexpr std::array<std::string_view, 6> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
+                                                               "xpbd", "projective"};
 constexpr std::array<std::string_view, 2> kContactModelNames = {"projection", "penalty"};
 constexpr std::array<std::string_view, 2> kClothShapeNames = {"rectangle", "disc"};
 

@@ -57,7 +57,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double contact_substep = contact_k > 0.0 && std::isfinite(lightest)
                                        ? critical(std::sqrt(contact_k / lightest), c, 2.0, DampingForm::None)
                                        : std::numeric_limits<double>::infinity();
-    if (integrator == Integrator::ImplicitEuler) {
+    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective) {
         limit.unconditionally_stable = !std::isfinite(contact_substep);
         limit.critical_substep = limit.plane_wave_substep = contact_substep;
         limit.wind_substep = std::numeric_limits<double>::infinity();

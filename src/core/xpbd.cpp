@@ -4,10 +4,12 @@
 
 #include <glm/geometric.hpp>
 
+#include <cmath>
+
 namespace clothsim {
 
 void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
-               double h) {
+               double h, XpbdMultipliers& multipliers) {
     const std::size_t n = state.size();
     state.substep = h;
     // External accelerations only (gravity, wind, damping): the springs are constraints here.
@@ -23,7 +25,11 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     }
     // One Gauss-Seidel pass over the springs; with lambda starting at 0 each substep,
     // d_lambda = -C / (w_a + w_b + 1 / (k h^2)).
-    for (const Spring& s : topology.springs) {
+    multipliers.spring.assign(topology.springs.size(), 0.0);
+    multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
+    double violation2 = 0.0;
+    for (std::size_t j = 0; j < topology.springs.size(); ++j) {
+        const Spring& s = topology.springs[j];
         const double k = stiffness_of(springs, s);
         if (k == 0.0) continue;
         const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
@@ -32,16 +38,22 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         if (!(length > 1e-12)) continue;
         const glm::dvec3 normal = d / length;
         const double lambda = -(length - s.rest_length) / (wa + wb + 1.0 / (k * h * h));
+        multipliers.spring[j] = lambda;
+        violation2 += (length - s.rest_length) * (length - s.rest_length);
         state.position.add(s.a, -wa * lambda * normal);
         state.position.add(s.b, wb * lambda * normal);
     }
     // Bends: the vector constraint C = x_a - 2 x_m + x_b with compliance 1 / (k h^2) and gradients I, -2 I, I:
     // d_lambda = -C / (w_a + 4 w_m + w_b + 1 / (k h^2)).
-    for (const Bend& b : topology.bends) {
+    for (std::size_t j = 0; j < topology.bends.size(); ++j) {
+        const Bend& b = topology.bends[j];
         const double k = stiffness_of(springs, b);
         if (k == 0.0) continue;
         const double wa = state.inverse_mass[b.a], wm = state.inverse_mass[b.m], wb = state.inverse_mass[b.b];
-        const glm::dvec3 lambda = -bend_difference(state.position, b) / (wa + 4.0 * wm + wb + 1.0 / (k * h * h));
+        const glm::dvec3 c = bend_difference(state.position, b);
+        const glm::dvec3 lambda = -c / (wa + 4.0 * wm + wb + 1.0 / (k * h * h));
+        multipliers.bend[j] = lambda;
+        violation2 += glm::dot(c, c);
         state.position.add(b.a, wa * lambda);
         state.position.add(b.m, -2.0 * wm * lambda);
         state.position.add(b.b, wb * lambda);
@@ -49,6 +61,34 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     for (std::size_t i = 0; i < n; ++i) {
         state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));
     }
+    multipliers.substep = h;
+    multipliers.initial_violation = std::sqrt(violation2);
+}
+
+double xpbd_residual(const DVec3Array& position, const Topology& topology, const SpringSettings& springs,
+                     const XpbdMultipliers& multipliers) {
+    if (multipliers.spring.size() != topology.springs.size() || multipliers.bend.size() != topology.bends.size()) {
+        return 0.0;  // no XPBD substep yet
+    }
+    const double h2 = multipliers.substep * multipliers.substep;
+    double residual2 = 0.0;
+    for (std::size_t j = 0; j < topology.springs.size(); ++j) {
+        const Spring& s = topology.springs[j];
+        const double k = stiffness_of(springs, s);
+        if (k == 0.0) continue;
+        const double c = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
+        const double r = c + multipliers.spring[j] / (k * h2);
+        residual2 += r * r;
+    }
+    for (std::size_t j = 0; j < topology.bends.size(); ++j) {
+        const Bend& b = topology.bends[j];
+        const double k = stiffness_of(springs, b);
+        if (k == 0.0) continue;
+        const glm::dvec3 r = bend_difference(position, b) + multipliers.bend[j] / (k * h2);
+        residual2 += glm::dot(r, r);
+    }
+    const double first = multipliers.initial_violation;
+    return first > 0.0 ? std::sqrt(residual2) / first : 0.0;
 }
 
 }  // namespace clothsim

@@ -347,7 +347,7 @@ TEST_CASE("cli: --obj naming a directory exits 2 before simulating") {
 }
 
 TEST_CASE("cli: every integrator can be chosen with --set and runs a bundled scene finite") {
-    for (const char* name : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd"}) {
+    for (const char* name : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd", "projective"}) {
         const RunResult r = run_clothsim({"--headless", "--scene", "drape-sphere", "--set", "cloth.rows=12", "--set",
                                           "cloth.cols=12", "--set", std::string("integration.integrator=") + name,
                                           "--duration", "0.5", "--json"});

@@ -203,8 +203,9 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
     CHECK(slide.position.get(0).x == Approx(0.01f));
 }
 
-TEST_CASE("colliders implicit Euler and XPBD at dt 0.1 with 1 substep drape the cloth on the sphere", "[colliders]") {
-    for (const char* integrator : {"implicit-euler", "xpbd"}) {
+TEST_CASE("colliders implicit Euler, XPBD and projective at dt 0.1 with 1 substep drape the cloth on the sphere",
+          "[colliders]") {
+    for (const char* integrator : {"implicit-euler", "xpbd", "projective"}) {
         INFO(integrator);
         Scene scene = per_spring_scene("drape-sphere");  // the springs this was measured with
         apply_override(scene, std::string("integration.integrator=") + integrator);
@@ -228,7 +229,7 @@ TEST_CASE("colliders a particle dropped on the cylinder's top face rests at top 
     const CylinderCollider cylinder = support(0.3f);
     const double top = double(cylinder.center.y) + 0.5 * double(cylinder.height);
     const double thickness = 0.005;
-    for (const char* integrator : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd"}) {
+    for (const char* integrator : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd", "projective"}) {
         INFO(integrator);
         // Off the axis, dropped from 0.2 m above the top: it lands at 2 m/s after 0.2 s.
         Scene s = lone_particle({0.13f, 0.6f, -0.17f}, glm::vec3(0.0f), 20);

@@ -28,6 +28,7 @@ double oscillator_error(Integrator integrator, int substeps_per_period, double c
     s.settings.integration.dt = static_cast<float>(h);
     s.settings.integration.integrator = integrator;
     s.settings.integration.tolerance = 1e-7f;
+    s.settings.integration.iterations = 100;
     MassSpring sim = build_simulation(s);
     sim.set_particle(1, {0.0f, static_cast<float>(-rest - amplitude), 0.0f}, glm::vec3(0.0f));
     double worst = 0.0;
@@ -48,7 +49,8 @@ double order(Integrator integrator, int n, double c) {
 
 }  // namespace
 
-TEST_CASE("integrators observed convergence orders: symplectic Euler 1, RK4 4, implicit Euler 1", "[integrators]") {
+TEST_CASE("integrators observed convergence orders: symplectic Euler 1, RK4 4, implicit Euler 1, projective 2",
+          "[integrators]") {
     for (double c : {0.0, 2.0}) {
         INFO("damping " << c << " 1/s");
         CHECK(order(Integrator::Verlet, 50, c) == Approx(2.0).margin(0.1));
@@ -58,6 +60,8 @@ TEST_CASE("integrators observed convergence orders: symplectic Euler 1, RK4 4, i
         CHECK(order(Integrator::Rk4, 12, c) == Approx(4.0).margin(0.3));
         CHECK(order(Integrator::Rk4, 25, c) == Approx(4.0).margin(0.3));
         CHECK(order(Integrator::ImplicitEuler, 400, c) == Approx(1.0).margin(0.15));
+        CHECK(order(Integrator::Projective, 50, c) == Approx(2.0).margin(0.15));  // BDF2
+        CHECK(order(Integrator::Projective, 100, c) == Approx(2.0).margin(0.1));
     }
 }
 
@@ -72,6 +76,7 @@ TEST_CASE("integrators match the analytic damped oscillator within their expecte
         CHECK(oscillator_error(Integrator::Rk4, 100, c) < 1e-4 * amplitude);
         CHECK(oscillator_error(Integrator::ImplicitEuler, 100, c) < 0.4 * amplitude);
         CHECK(oscillator_error(Integrator::Xpbd, 100, c) < 0.4 * amplitude);
+        CHECK(oscillator_error(Integrator::Projective, 100, c) < 0.03 * amplitude);
     }
 }
 
@@ -92,16 +97,17 @@ TEST_CASE("integrators switching mid-run keeps position and velocity", "[integra
     s.settings.integration.dt = 0.001f;
     MassSpring sim = build_simulation(s);
     for (Integrator next : {Integrator::Rk4, Integrator::SymplecticEuler, Integrator::ImplicitEuler,
-                            Integrator::Xpbd, Integrator::Verlet}) {
+                            Integrator::Xpbd, Integrator::Projective, Integrator::Verlet}) {
         sim.run_steps(100);
         test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = next; });
     }
-    sim.run_steps(100);  // 0.6 s of free fall through five integrators
-    CHECK(sim.velocities()[0].y == Approx(-9.81 * 0.6).epsilon(2e-3));
-    CHECK(sim.position(0).y == Approx(-0.5 * 9.81 * 0.36).epsilon(5e-3));
+    sim.run_steps(100);  // 0.7 s of free fall through six integrators
+    CHECK(sim.velocities()[0].y == Approx(-9.81 * 0.7).epsilon(2e-3));
+    CHECK(sim.position(0).y == Approx(-0.5 * 9.81 * 0.49).epsilon(5e-3));
 }
 
-TEST_CASE("integrators implicit Euler stays stable far beyond the explicit step limit", "[integrators]") {
+TEST_CASE("integrators implicit Euler and projective stay stable far beyond the explicit step limit",
+          "[integrators]") {
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 16;
     s.settings.integration.substeps = 1;  // h = 16.7 ms: about 20x Verlet's limit for these springs
@@ -110,18 +116,21 @@ TEST_CASE("integrators implicit Euler stays stable far beyond the explicit step 
     MassSpring verlet = build_simulation(s);
     verlet.run_steps(60);
     CHECK_FALSE(verlet.all_finite());  // explicit: blows up
-    s.settings.integration.integrator = Integrator::ImplicitEuler;
-    MassSpring implicit = build_simulation(s);
-    const double e0 = implicit.energy().total();
-    implicit.run_steps(60);
-    CHECK(implicit.all_finite());
-    CHECK(implicit.energy().total() < e0);  // backward Euler only dissipates
-    CHECK(implicit.last_solver_iterations() > 0);
+    for (Integrator integrator : {Integrator::ImplicitEuler, Integrator::Projective}) {
+        INFO("integrator " << static_cast<int>(integrator));
+        s.settings.integration.integrator = integrator;
+        MassSpring implicit = build_simulation(s);
+        const double e0 = implicit.energy().total();
+        implicit.run_steps(60);
+        CHECK(implicit.all_finite());
+        CHECK(implicit.energy().total() < e0);  // backward Euler and BDF2 dissipate at large steps
+        CHECK(implicit.last_solver_iterations() > 0);
+    }
 }
 
 TEST_CASE("integrators all keep pins fixed and particles outside the colliders", "[integrators]") {
     for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::Rk4, Integrator::ImplicitEuler,
-                                  Integrator::Xpbd}) {
+                                  Integrator::Xpbd, Integrator::Projective}) {
         Scene s = per_spring_scene("drape-sphere");  // 38 substeps a step keep implicit Euler's 90 steps short
         s.cloth.rows = s.cloth.cols = 20;
         s.pins.particles = {{0, 0}};
@@ -137,4 +146,27 @@ TEST_CASE("integrators all keep pins fixed and particles outside the colliders",
             CHECK(signed_distance(s.settings.colliders.ground, sim.position(i)) >= 0.0f);
         }
     }
+}
+
+TEST_CASE("integrators XPBD reports its constraint residual: none for one spring, some for a cloth", "[integrators]") {
+    // One spring, one free end: a single projection solves C + alpha~ lambda = 0 exactly.
+    Scene chain = test::chain(2, 0.5f, 0.1f, 100.0f);
+    chain.pins.particles = {{0, 0}};
+    chain.settings.integration.integrator = Integrator::Xpbd;
+    chain.settings.integration.substeps = 4;
+    MassSpring one = build_simulation(chain);
+    one.set_particle(1, {0.0f, -0.55f, 0.0f}, glm::vec3(0.0f));
+    one.run_steps(3);
+    CHECK(one.last_solver_iterations() == 1);
+    CHECK(one.last_solver_residual() < 1e-9);
+    // A cloth: each projection disturbs its neighbours, so one Gauss-Seidel pass leaves a residual.
+    Scene s = per_spring_scene("hanging");
+    s.cloth.rows = s.cloth.cols = 12;
+    s.settings.colliders.ground.enabled = false;
+    s.settings.integration.integrator = Integrator::Xpbd;
+    MassSpring cloth = build_simulation(s);
+    cloth.run_steps(10);
+    INFO("residual " << cloth.last_solver_residual());
+    CHECK(cloth.last_solver_residual() > 1e-3);
+    CHECK(cloth.last_solver_residual() < 1.0);
 }

@@ -3,6 +3,7 @@
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
+#include "fma_peak.hpp"
 #include "skipping.hpp"
 #include "stability_sweep.hpp"
 #include "stiff_precision.hpp"
@@ -217,15 +218,22 @@ int main(int argc, char** argv) {
         budgets.push_back({size, 1e3 * substep, 1e3 * prep, left > 0 ? static_cast<long long>(left / substep) : 0});
     }
 
-    std::printf("%6s %9s %9s %12s %7s %12s %12s %12s %10s %9s %9s\n", "size", "particles", "springs", "method",
-                "threads", "ns/particle", "ns/spring", "steps/s", "B/particle", "vs soa", "vs aos");
+    // The kernel's arithmetic rate against the FMA peak of the vectors it uses, per core it ran on.
+    const std::string kernel = MassSpring::fast_kernel_name();
+    const double peak = bench::fma_peak_gflops(kernel);
+    auto gflops = [](const Row& r) { return bench::kFlopsPerSpring * r.springs / r.seconds_per_step * 1e-9; };
+    std::printf("%6s %9s %9s %12s %7s %12s %12s %12s %10s %9s %9s %8s %8s\n", "size", "particles", "springs",
+                "method", "threads", "ns/particle", "ns/spring", "steps/s", "B/particle", "vs soa", "vs aos",
+                "GFLOP/s", "of peak");
     for (const Row& r : rows) {
-        std::printf("%6d %9zu %9zu %12s %7d %12.3f %12.4f %12.0f %10.0f %9.2f %9.2f\n", r.size, r.particles,
-                    r.springs, r.method.c_str(), r.threads, 1e9 * r.seconds_per_step / r.particles,
+        std::printf("%6d %9zu %9zu %12s %7d %12.3f %12.4f %12.0f %10.0f %9.2f %9.2f %8.1f %7.1f%%\n", r.size,
+                    r.particles, r.springs, r.method.c_str(), r.threads, 1e9 * r.seconds_per_step / r.particles,
                     1e9 * r.seconds_per_step / r.springs, 1.0 / r.seconds_per_step, state_bytes_per_particle(r.method),
-                    r.speedup, r.speedup_aos);
+                    r.speedup, r.speedup_aos, gflops(r), 100.0 * gflops(r) / (peak * r.threads));
     }
-    std::printf("\nfast solver kernel: %s\n", MassSpring::fast_kernel_name());
+    std::printf("\nfast solver kernel: %s; its FMA peak on one core, measured: %.1f GFLOP/s (%.0f flops counted "
+                "per spring: bench/fma_peak.hpp)\n",
+                kernel.c_str(), peak, bench::kFlopsPerSpring);
     std::printf("frame budget %.1f ms (fast solver, %d threads):\n", budget_ms,
                 build_simulation(grid_scene(scene, 32, SolverMethod::Fast, 0)).solver_threads());
     for (const Budget& b : budgets) {
@@ -234,7 +242,9 @@ int main(int argc, char** argv) {
     }
     if (!json_path.empty()) {
         nlohmann::json j;
-        j["kernel"] = MassSpring::fast_kernel_name();
+        j["kernel"] = kernel;
+        j["fma_peak_gflops_per_core"] = peak;
+        j["flops_per_spring"] = bench::kFlopsPerSpring;
         for (const Row& r : rows) {
             j["rows"].push_back({{"size", r.size}, {"particles", r.particles}, {"springs", r.springs},
                                  {"method", r.method}, {"threads", r.threads},
@@ -242,7 +252,8 @@ int main(int argc, char** argv) {
                                  {"ns_per_spring_step", 1e9 * r.seconds_per_step / r.springs},
                                  {"steps_per_second", 1.0 / r.seconds_per_step},
                                  {"state_bytes_per_particle", state_bytes_per_particle(r.method)},
-                                 {"speedup_vs_textbook", r.speedup}, {"speedup_vs_textbook_aos", r.speedup_aos}});
+                                 {"speedup_vs_textbook", r.speedup}, {"speedup_vs_textbook_aos", r.speedup_aos},
+                                 {"gflops", gflops(r)}, {"fraction_of_fma_peak", gflops(r) / (peak * r.threads)}});
         }
         for (const Budget& b : budgets) {
             j["frame_budget"].push_back({{"size", b.size}, {"budget_ms", budget_ms}, {"substep_ms", b.substep_ms},

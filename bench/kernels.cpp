@@ -81,11 +81,14 @@ void BM_CollideSphere(benchmark::State& state) {
         benchmark::Counter(static_cast<double>(st.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Arg 1: 1 = the grid sweep (Topology::cell_triangles), 0 = the same triangles walked as a list.
 void BM_VertexNormals(benchmark::State& state) {
     MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Fast, 1);
+    Topology topology = sim.topology();
+    topology.cell_triangles = state.range(1) != 0;
     std::vector<glm::vec3> normals;
     for (auto _ : state) {
-        compute_vertex_normals(sim.topology(), sim.state().position, normals);
+        compute_vertex_normals(topology, sim.state().position, normals);
         benchmark::DoNotOptimize(normals.data());
     }
     state.counters["particles/s"] = benchmark::Counter(static_cast<double>(sim.particle_count()),
@@ -99,6 +102,6 @@ BENCHMARK(BM_TextbookSubstep)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_FastSubstep)->Args({64, 1})->Args({128, 1})->Args({256, 1})->Args({128, 2})->Args({256, 2})->UseRealTime();
 BENCHMARK(BM_IntegrateVerlet)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_CollideSphere)->Arg(64)->Arg(128)->Arg(256);
-BENCHMARK(BM_VertexNormals)->Arg(64)->Arg(128)->Arg(256);
+BENCHMARK(BM_VertexNormals)->Args({128, 0})->Args({128, 1})->Args({256, 0})->Args({256, 1})->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -57,6 +57,9 @@ struct Topology {
     std::vector<Spring> springs;
     std::vector<Bend> bends;  // the material form's bending (kind Bending); the per-spring form has none
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
+    // The triangles are every grid cell's two, in row-major cell order: (00, 01, 10) and (01, 11, 10) for the
+    // cell's corners (row, col) = 00. The builder sets it for rectangles; normals.cpp then sweeps the grid.
+    bool cell_triangles = false;
     std::array<std::size_t, kSpringKindCount> spring_count_by_kind{};  // bends count as Bending
 
     std::size_t index(int row, int col) const { return static_cast<std::size_t>(row) * cols + col; }

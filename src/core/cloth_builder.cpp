@@ -86,6 +86,8 @@ Topology grid_topology(const ShapeMask& shape, const DVec3Array& position, bool 
             t.triangles.push_back({i01, i11, i10});
         }
     }
+    t.cell_triangles = rows > 1 && cols > 1 &&
+                       t.triangles.size() == 2 * static_cast<std::size_t>(rows - 1) * static_cast<std::size_t>(cols - 1);
     return t;
 }
 

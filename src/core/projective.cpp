@@ -237,16 +237,16 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
 
     // The positions every local step reads: the pinned ones from the state, the free ones from x.
     DVec3Array& position = state.position;
-    auto write = [&](const Positions& x) {
-        for (int r = 0; r < rows; ++r) position.set(f.particle[r], glm::dvec3(x(r, 0), x(r, 1), x(r, 2)));
+    auto write = [&](const Positions& at) {
+        for (int r = 0; r < rows; ++r) position.set(f.particle[r], glm::dvec3(at(r, 0), at(r, 1), at(r, 2)));
     };
     // At the positions last written (x for the free particles): g(x), returned, and the local step's
     // right-hand side b(x) in `rhs`, in one pass over the springs. The local step gives each spring its target
     // d_s = L0 (x_b - x_a)/|x_b - x_a| and adds k d_s on b, -k d_s on a; then grad g(x) = A x - b(x).
     Positions rhs(rows, 3);
-    auto evaluate = [&](const Positions& x) {
+    auto evaluate = [&](const Positions& at) {
         rhs = constant;
-        double e = 0.5 * (f.inertia.asDiagonal() * (x - target)).cwiseProduct(x - target).sum();
+        double e = 0.5 * (f.inertia.asDiagonal() * (at - target)).cwiseProduct(at - target).sum();
         for (const Spring& s : topology.springs) {
             const double k = stiffness_of(springs, s);
             if (k == 0.0) continue;

@@ -211,3 +211,31 @@ TEST_CASE("cloth_builder: a clip holds the particles within its radius of the bu
     // within 0.23 m for 19 (a, b); perpendicular axes would hold 21.
     CHECK(pinned == 19);
 }
+
+TEST_CASE("cloth_builder: grid normals are the triangle list's, bit for bit, threaded or not", "[cloth_builder]") {
+    for (int n : {2, 3, 17, 130, 260}) {
+        Scene s;
+        s.cloth.rows = n;
+        s.cloth.cols = n + 3;
+        MassSpring sim = build_simulation(s);
+        REQUIRE(sim.topology().cell_triangles);
+        // A crumpled cloth: every vertex moved by a different amount, so no two normals agree by symmetry.
+        DVec3Array p = sim.state().position;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            const double t = static_cast<double>(i);
+            p.add(i, {0.05 * std::sin(0.7 * t), 0.05 * std::cos(1.3 * t), 0.03 * std::sin(2.1 * t + 0.4)});
+        }
+        Topology list = sim.topology();
+        list.cell_triangles = false;  // the same triangles, summed by walking the list
+        std::vector<glm::vec3> grid_normals, list_normals;
+        compute_vertex_normals(sim.topology(), p, grid_normals);
+        compute_vertex_normals(list, p, list_normals);
+        INFO(n << " x " << n + 3);
+        REQUIRE(grid_normals.size() == list_normals.size());
+        CHECK(grid_normals == list_normals);
+    }
+    // A disc leaves cells out: it is no full grid and takes the list.
+    Scene disc;
+    disc.cloth.shape = ClothShape::Disc;
+    CHECK_FALSE(build_simulation(disc).topology().cell_triangles);
+}

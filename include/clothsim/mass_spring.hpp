@@ -102,6 +102,10 @@ public:
     // limit in the last substep.
     std::size_t tether_count() const { return tethers_.size(); }
     std::size_t tethers_at_limit() const { return tethers_at_limit_; }
+    // Springs (and bends) broken by tearing since the cloth was built (springs.tear_strain; tearing.hpp).
+    std::size_t broken_springs() const { return broken_springs_; }
+    // Changes whenever the springs or triangles change (a tear), so a renderer rebuilds its mesh.
+    std::uint64_t topology_stamp() const { return topology_stamp_; }
     // How far the last substep's solve got (0 for the explicit integrators): implicit Euler's CG iterations and
     // |b - A dv| / |b|; projective's quasi-Newton iterations and relative force imbalance (projective.hpp);
     // XPBD's one iteration and its constraint residual |C + alpha~ lambda| / |C| at the current positions.
@@ -170,6 +174,8 @@ private:
     void collide(StepProfile* profile);
     void limit_strain();
     void limit_speed(double h);
+    void tear();
+    void rebuild_tethers();
     void check_sleep(double h);
     glm::vec3 grab_force(const State& state) const;
 
@@ -206,6 +212,8 @@ private:
     FastSolverHolder fast_;      // the fast solver, when the topology is a grid
     IterativeSolvers iterative_;
     std::uint64_t history_stamp_ = 0;  // stamp_ as the last substep left it; 0 after a restart
+    std::size_t broken_springs_ = 0;
+    std::uint64_t topology_stamp_ = 0;
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;

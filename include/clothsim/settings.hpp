@@ -94,6 +94,7 @@ struct SpringSettings {
     // fraction: 0 = off; otherwise each free particle stays within (1 + it) x its rest distance of the pins it
     // hangs from (tethers.hpp)
     float tether_strain = 0.0f;
+    float tear_strain = 0.0f;  // fraction: 0 = off; otherwise a spring longer than (1 + it) L0 breaks (tearing.hpp)
     bool operator==(const SpringSettings&) const = default;
 };
 

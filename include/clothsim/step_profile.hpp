@@ -26,6 +26,7 @@ enum class Stage {
     Tethers,     // long-range attachments to the pins (tethers.hpp)
     StrainLimit, // Provot's strain limit
     SpeedLimit,  // the max_speed clamp
+    Tear,        // the once-per-step check for springs beyond springs.tear_strain (tearing.hpp)
     Sleep,       // the once-per-step check of whether the cloth may sleep
     Count,
 };

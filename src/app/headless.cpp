@@ -175,6 +175,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"max_strain", finite_or_null(max_membrane_strain(sim.topology(), sim.state().position))},
         {"tethers", sim.tether_count()},
         {"tethers_at_limit", sim.plan().tethers ? sim.tethers_at_limit() : 0},
+        {"broken_springs", sim.broken_springs()},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
     // Which solver ran and, for an iterative one, how far its last solve got.

@@ -1,6 +1,7 @@
 #include "clothsim/mass_spring.hpp"
 
 #include "clothsim/colliders.hpp"
+#include "clothsim/tearing.hpp"
 #include "clothsim/tethers.hpp"
 #include "forces.hpp"
 #include "fast_solver.hpp"
@@ -72,6 +73,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
             substep_length());
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
+    topology_stamp_ = next_stamp();
 }
 
 struct MassSpring::IterativeSolvers::Data {
@@ -174,6 +176,10 @@ void MassSpring::step() {
     history_stamp_ = stamp_;
     if (++substeps_since_check_ >= settings_.integration.substeps) {
         substeps_since_check_ = 0;
+        if (plan_.tear) {
+            StageTimer timer(profile, Stage::Tear);
+            tear();
+        }
         if (plan_.may_sleep) {
             StageTimer timer(profile, Stage::Sleep);
             check_sleep(h);
@@ -220,6 +226,40 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
 void MassSpring::collide(StepProfile* profile) {
     if (!plan_.any_collider()) return;
     collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
+}
+
+// Springs beyond tear_strain break (tearing.hpp). The rest follows the new topology at the point of change:
+// the fast solver's layout, the projective matrix, the tethers (a piece torn off is no longer held by the
+// pins it hung from), the plan, and the stamps the renderer and the stability limit watch.
+void MassSpring::tear() {
+    const std::size_t removed = tear_springs(topology_, state_.position, settings_.springs.tear_strain);
+    if (removed == 0) return;
+    broken_springs_ += removed;
+    fast_ = FastSolverHolder{};
+    if (auto solver = FastSolver::for_topology(topology_)) {
+        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
+    }
+    iterative_.invalidate_matrix();
+    rebuild_tethers();
+    replan();
+    setup_stamp_ = next_stamp();
+    topology_stamp_ = next_stamp();
+}
+
+// Tethers to the current pins; after a tear only within each piece (a piece torn off falls freely).
+void MassSpring::rebuild_tethers() {
+    tethers_ = build_tethers(topology_, state_, rest_position_);
+    tethers_at_limit_ = 0;
+    if (broken_springs_ == 0 || tethers_.empty()) return;
+    const std::vector<std::uint32_t> piece = connected_pieces(topology_, state_.size());
+    Tethers kept;
+    for (std::size_t t = 0; t < tethers_.size(); ++t) {
+        if (piece[tethers_.particle[t]] != piece[tethers_.anchor[t]]) continue;
+        kept.particle.push_back(tethers_.particle[t]);
+        kept.anchor.push_back(tethers_.anchor[t]);
+        kept.rest.push_back(tethers_.rest[t]);
+    }
+    tethers_ = std::move(kept);
 }
 
 void MassSpring::replan() {
@@ -522,8 +562,7 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
     iterative_.invalidate_matrix();  // its matrix is over the free particles
-    tethers_ = build_tethers(topology_, state_, rest_position_);  // the pins the cloth hangs from changed
-    tethers_at_limit_ = 0;
+    rebuild_tethers();  // the pins the cloth hangs from changed
     replan();
 }
 

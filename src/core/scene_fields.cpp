@@ -47,6 +47,7 @@ const std::array kFields = {
     FieldInfo{"springs.bending", "N/m", 0, 1e9, "stiffness of each spring two apart along rows and columns: one number, or [along u, along v] (with [material]: each bend's k = B h_v / h_u^3, derived)", [](Scene& s) -> FieldRef { return &s.settings.springs.bending; }},
     FieldInfo{"springs.damping", "1/s", 0, 1e4, "velocity damping rate c in x'' = a - c x' (independent of dt)", [](Scene& s) -> FieldRef { return &s.settings.springs.damping; }},
     FieldInfo{"springs.tether_strain", "", 0, 10, "0 = off; else tethers (long-range attachments, Kim et al. 2012): each free particle stays within (1 + this) x its rest distance of the pins it hangs from (0.01 = 1%)", [](Scene& s) -> FieldRef { return &s.settings.springs.tether_strain; }},
+    FieldInfo{"springs.tear_strain", "", 0, 10, "0 = off; else a spring stretched beyond (1 + this) x its rest length breaks, checked once per step (0.5 = 50%)", [](Scene& s) -> FieldRef { return &s.settings.springs.tear_strain; }},
     FieldInfo{"springs.strain_limit", "", 0, 10, "0 = off; else Provot's limit: no spring ends a substep longer than (1 + this) x its rest length (0.1 = 10%)", [](Scene& s) -> FieldRef { return &s.settings.springs.strain_limit; }},
 
     FieldInfo{"forces.gravity", "m/s^2", -1e5, 1e5, "gravitational acceleration", [](Scene& s) -> FieldRef { return &s.settings.forces.gravity; }},

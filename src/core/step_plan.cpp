@@ -19,6 +19,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Ground: return "ground";
         case Stage::Tethers: return "tethers";
         case Stage::StrainLimit: return "strain limit";
+        case Stage::Tear: return "tear";
         case Stage::SpeedLimit: return "speed limit";
         case Stage::Sleep: return "sleep check";
         case Stage::Count: break;
@@ -71,6 +72,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     plan.tethers = settings.springs.tether_strain > 0.0f && tethers;
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
     plan.speed_limit = settings.forces.max_speed > 0.0f;
+    plan.tear = settings.springs.tear_strain > 0.0f;
     plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
     return plan;
 }
@@ -164,6 +166,8 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
                    plan.tethers ? "" : (settings.springs.tether_strain > 0.0f ? "no pins to tie to" : "springs.tether_strain is 0")});
     out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
     out.push_back({Stage::SpeedLimit, when(plan.speed_limit, Skipped), plan.speed_limit ? "" : "forces.max_speed is 0"});
+    out.push_back({Stage::Tear, when(plan.tear, Skipped),
+                   plan.tear ? "once per step" : "springs.tear_strain is 0"});
     out.push_back({Stage::Sleep, when(plan.may_sleep, Skipped),
                    plan.may_sleep ? "" : (settings.solver.sleep_speed > 0.0f ? "forces.wind keeps it awake"
                                                                              : "solver.sleep_speed is 0")});

@@ -143,7 +143,8 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
     using Clock = std::chrono::steady_clock;
     cloth_timings_.normals_ms = cloth_timings_.upload_ms = 0.0f;
     cloth_timings_.cloth_uploaded = false;
-    rebuild = rebuild || !cloth_ || positions_.size() != sim.particle_count();
+    rebuild = rebuild || !cloth_ || positions_.size() != sim.particle_count() ||
+              sim.topology_stamp() != synced_topology_stamp_;  // a tear changed the triangles
     if (!rebuild && sim.change_stamp() == synced_stamp_) {
         ++cloth_timings_.skipped;  // nothing moved (a sleeping or paused cloth): the GPU has these positions
         return;
@@ -176,6 +177,7 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
         cloth_->update_positions_normals(positions_, normals_);
     }
     synced_stamp_ = sim.change_stamp();
+    synced_topology_stamp_ = sim.topology_stamp();
     cloth_timings_.normals_ms = std::chrono::duration<float, std::milli>(normals_done - start).count();
     cloth_timings_.upload_ms = std::chrono::duration<float, std::milli>(Clock::now() - normals_done).count();
     cloth_timings_.cloth_uploaded = true;

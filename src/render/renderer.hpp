@@ -105,6 +105,7 @@ private:
     std::optional<GpuMesh> cloth_;
     std::vector<glm::vec3> positions_, normals_;
     std::uint64_t synced_stamp_ = 0;  // the change_stamp of positions_ (0: none; stamps start at 1)
+    std::uint64_t synced_topology_stamp_ = 0;  // the topology_stamp the mesh's triangles belong to
     ClothTimings cloth_timings_;
     glm::vec2 cloth_uv_scale_{1.0f};
 

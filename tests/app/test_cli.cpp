@@ -190,7 +190,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 14);
+    CHECK(stage.size() == 15);
     // drape-sphere: fast solver, sphere and ground, no wind, no cube, no cylinder, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 109);
@@ -276,7 +276,7 @@ TEST_CASE("cli: the text report of a headless run") {
 TEST_CASE("cli: an unknown scene exits 2 and lists the bundled scenes") {
     expect_bad_input({"--headless", "--scene", "no-such-scene"},
                      {"unknown scene", "no-such-scene", "curtain", "drape-cube", "drape-sphere", "falling", "flag",
-                      "hanging", "stiff-drape", "stiff-hanging"});
+                      "hanging", "stiff-drape", "stiff-hanging", "tear"});
 }
 
 TEST_CASE("cli: a bad --set exits 2 and names the field") {
@@ -545,7 +545,7 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CHECK(r.code == 0);
     CHECK(lines_of(r.out) ==
           std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "hanging",
-                                   "stiff-drape", "stiff-hanging"});
+                                   "stiff-drape", "stiff-hanging", "tear"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

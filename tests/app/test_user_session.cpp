@@ -219,8 +219,8 @@ TEST_CASE("user session: typed out-of-range values are clamped with a note, and 
     const TempDir dir("session_typed");
     // Forces open; wind speed typed 1e9 (allowed |wind| components up to 1e4), damping typed 1e9.
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
-                                         "click 50 358\n"
-                                         "ctrl_click 117 542\nkey ctrl+a\ntype 1e9\nkey Return\n"
+                                         "click 50 381\n"
+                                         "ctrl_click 117 565\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "click 285 151\nquit\n");
     CAPTURE_RUN(r);

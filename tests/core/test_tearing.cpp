@@ -1,0 +1,160 @@
+// Tearing (tearing.hpp): springs beyond springs.tear_strain break, once per step.
+#include "support.hpp"
+
+#include "clothsim/export.hpp"
+#include "clothsim/scene.hpp"
+#include "clothsim/tearing.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <utility>
+
+using namespace clothsim;
+
+namespace {
+
+bool has_spring(const Topology& t, std::uint32_t a, std::uint32_t b) {
+    for (const Spring& s : t.springs) {
+        if ((s.a == a && s.b == b) || (s.a == b && s.b == a)) return true;
+    }
+    return false;
+}
+
+// A free 12 x 12 sheet in zero gravity whose left half moves left and right half moves right: it tears
+// down the middle.
+MassSpring pulled_apart(SolverMethod method, float speed) {
+    Scene s;
+    s.cloth.rows = s.cloth.cols = 12;
+    s.pins.preset = PinPreset::None;
+    s.settings.forces.gravity = glm::vec3(0.0f);
+    s.settings.colliders.ground.enabled = false;
+    s.settings.springs.damping = 0.0f;
+    s.settings.springs.tear_strain = 0.2f;
+    s.settings.solver.method = method;
+    s.settings.solver.sleep_speed = 0.0f;
+    MassSpring sim = build_simulation(s);
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const int col = static_cast<int>(i) % 12;
+        sim.set_particle(i, sim.position(i), glm::vec3(col < 6 ? -speed : speed, 0.0f, 0.0f));
+    }
+    return sim;
+}
+
+}  // namespace
+
+TEST_CASE("tearing: a hanging chain breaks at its top spring, which carries the most weight", "[tearing]") {
+    // Ten 10 g particles on 10 N/m springs 0.1 m long under gravity, damped so that no spring overshoots
+    // its static strain: spring j from the top holds the 9 - j particles below it, strain (9 - j) m g / (k L):
+    // 0.88 at the top, 0.78 next. A tear strain between them breaks the top spring alone.
+    Scene s = test::chain(10, 0.1f, 0.01f, 10.0f);
+    s.pins.particles = {{0, 0}};
+    s.settings.forces.gravity = {0.0f, -9.81f, 0.0f};
+    s.settings.springs.damping = 20.0f;
+    s.settings.springs.tear_strain = 0.84f;
+    s.settings.integration.substeps = 50;
+    s.settings.solver.sleep_speed = 0.0f;
+    MassSpring sim = build_simulation(s);
+    double top_strain_before = 0.0;
+    for (int step = 0; step < 600 && sim.broken_springs() == 0; ++step) {
+        top_strain_before = glm::length(sim.state().position.get(1) - sim.state().position.get(0)) / 0.1 - 1.0;
+        sim.run_steps(1);
+    }
+    INFO("top spring's strain in the step before the tear: " << top_strain_before);
+    REQUIRE(sim.broken_springs() > 0);
+    auto structural = [&] { return sim.topology().spring_count_by_kind[static_cast<int>(SpringKind::Structural)]; };
+    CHECK(structural() == 8);  // of 9: the top one (the skip-one spring across it, of stiffness 0, goes too)
+    CHECK_FALSE(has_spring(sim.topology(), 0, 1));
+    CHECK(has_spring(sim.topology(), 1, 2));
+    const std::size_t broken = sim.broken_springs();
+    const float bottom = sim.position(9).y;
+    sim.run_steps(60);  // the rest falls (at up to g / c = 0.49 m/s): nothing else is under tension
+    CHECK(sim.broken_springs() == broken);
+    CHECK(sim.position(9).y < bottom - 0.3f);
+}
+
+TEST_CASE("tearing: momentum is kept and the energy never rises at a tear", "[tearing]") {
+    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    const double e0 = sim.energy().total();
+    const glm::vec3 p0 = sim.momentum();
+    REQUIRE(glm::length(p0) < 1e-6f);
+    double largest_rise = 0.0;
+    int tears = 0;
+    for (int step = 0; step < 60; ++step) {
+        const std::size_t broken = sim.broken_springs();
+        const double before = sim.energy().total();
+        sim.run_steps(1);
+        const double after = sim.energy().total();
+        if (sim.broken_springs() > broken) {
+            ++tears;
+            largest_rise = std::max(largest_rise, after - before);
+        }
+        CHECK(glm::length(sim.momentum() - p0) < 1e-5f);
+    }
+    INFO("tears in " << tears << " steps; largest energy change over a tearing step " << largest_rise << " J; start "
+                     << e0 << " J");
+    REQUIRE(tears > 0);
+    CHECK(sim.broken_springs() > 0);
+    CHECK(largest_rise <= 1e-4 * e0);  // Verlet's own energy wobble over a step is below this
+    CHECK(sim.energy().total() < e0);
+    // Torn down the middle: the two halves are separate pieces.
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    CHECK(piece[0] != piece[11]);
+}
+
+TEST_CASE("tearing: the fast solver tears exactly as the textbook solver", "[tearing]") {
+    MassSpring fast = pulled_apart(SolverMethod::Fast, 8.0f);
+    MassSpring textbook = pulled_apart(SolverMethod::Textbook, 8.0f);
+    for (int step = 0; step < 40; ++step) {
+        fast.run_steps(1);
+        textbook.run_steps(1);
+    }
+    REQUIRE(fast.broken_springs() > 0);
+    CHECK(fast.plan().path == StepPath::Fast);
+    CHECK(fast.broken_springs() == textbook.broken_springs());
+    CHECK(test::bit_identical(fast, textbook));
+}
+
+TEST_CASE("tearing: no triangle spans a torn spring, in the topology and in the OBJ export", "[tearing]") {
+    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    const std::size_t triangles = sim.topology().triangles.size();
+    sim.run_steps(40);
+    REQUIRE(sim.broken_springs() > 0);
+    const Topology& t = sim.topology();
+    CHECK(t.triangles.size() < triangles);
+    CHECK_FALSE(t.cell_triangles);
+    for (const auto& tri : t.triangles) {
+        CHECK(has_spring(t, tri[0], tri[1]));
+        CHECK(has_spring(t, tri[1], tri[2]));
+        CHECK(has_spring(t, tri[2], tri[0]));
+    }
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("clothsim-torn-" + std::to_string(::getpid()) + ".obj")).string();
+    std::string error;
+    REQUIRE(write_obj(sim, path, error));
+    std::ifstream in(path);
+    std::size_t faces = 0;
+    for (std::string line; std::getline(in, line);) faces += line.rfind("f ", 0) == 0 ? 1 : 0;
+    in.close();
+    std::filesystem::remove(path);
+    CHECK(faces == t.triangles.size());
+}
+
+TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {
+    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    test::edit_settings(sim, [](SimulationSettings& s) { s.springs.tear_strain = 0.0f; });
+    CHECK_FALSE(sim.plan().tear);
+    sim.run_steps(40);
+    CHECK(sim.broken_springs() == 0);
+    bool said = false;
+    for (const StageStatus& st : describe(sim.plan(), sim.topology(), sim.settings())) {
+        if (st.stage == Stage::Tear) said = st.note == "springs.tear_strain is 0" && !st.runs();
+    }
+    CHECK(said);
+}

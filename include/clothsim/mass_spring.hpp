@@ -176,6 +176,7 @@ private:
     void limit_speed(double h);
     void tear();
     void rebuild_tethers();
+    void build_fast_solver();
     void check_sleep(double h);
     glm::vec3 grab_force(const State& state) const;
 

@@ -63,6 +63,12 @@ struct Topology {
     std::array<std::size_t, kSpringKindCount> spring_count_by_kind{};  // bends count as Bending
 
     std::size_t index(int row, int col) const { return static_cast<std::size_t>(row) * cols + col; }
+    // Fills spring_count_by_kind from the lists (after a hand-made topology or a tear changed them).
+    void count_by_kind() {
+        spring_count_by_kind = {};
+        for (const Spring& s : springs) ++spring_count_by_kind[static_cast<int>(s.kind)];
+        spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += bends.size();
+    }
 };
 
 // The simulation state, in double precision. A substep changes a position by its motion, which at small

@@ -51,9 +51,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
         throw std::invalid_argument("MassSpring: state arrays and initial velocities must have equal length");
     }
     // The plan reads the counts; a hand-made topology may not have filled them in.
-    topology_.spring_count_by_kind = {};
-    for (const Spring& s : topology_.springs) ++topology_.spring_count_by_kind[static_cast<int>(s.kind)];
-    topology_.spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += topology_.bends.size();
+    topology_.count_by_kind();
     for (const auto& t : topology_.triangles) {
         const glm::dvec3 a = state_.position.get(t[0]);
         rest_area_ += static_cast<float>(
@@ -61,9 +59,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     }
     force_.resize(n);
     state_.motion.resize(n);
-    if (auto solver = FastSolver::for_topology(topology_)) {
-        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
-    }
+    build_fast_solver();
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
     rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
     tethers_ = build_tethers(topology_, state_, rest_position_);
@@ -235,15 +231,20 @@ void MassSpring::tear() {
     const std::size_t removed = tear_springs(topology_, state_.position, settings_.springs.tear_strain);
     if (removed == 0) return;
     broken_springs_ += removed;
-    fast_ = FastSolverHolder{};
-    if (auto solver = FastSolver::for_topology(topology_)) {
-        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
-    }
+    build_fast_solver();
     iterative_.invalidate_matrix();
     rebuild_tethers();
     replan();
     setup_stamp_ = next_stamp();
     topology_stamp_ = next_stamp();
+}
+
+// The fast solver's layout of the current topology, or none when it is no grid.
+void MassSpring::build_fast_solver() {
+    fast_ = FastSolverHolder{};
+    if (auto solver = FastSolver::for_topology(topology_)) {
+        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
+    }
 }
 
 // Tethers to the current pins; after a tear only within each piece (a piece torn off falls freely).

@@ -52,9 +52,7 @@ std::size_t tear_springs(Topology& topology, const DVec3Array& position, float t
                broken.count(pair_key(t[2], t[0])) != 0;
     });
     if (topology.triangles.size() != triangles) topology.cell_triangles = false;
-    topology.spring_count_by_kind = {};
-    for (const Spring& s : topology.springs) ++topology.spring_count_by_kind[static_cast<int>(s.kind)];
-    topology.spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += topology.bends.size();
+    topology.count_by_kind();
     return removed;
 }
 

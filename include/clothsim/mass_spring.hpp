@@ -26,6 +26,7 @@
 #include "clothsim/step_plan.hpp"
 #include "clothsim/step_profile.hpp"
 #include "clothsim/colliders.hpp"
+#include "clothsim/self_collision.hpp"
 #include "clothsim/tethers.hpp"
 
 #include <glm/vec3.hpp>
@@ -104,6 +105,8 @@ public:
     std::size_t tethers_at_limit() const { return tethers_at_limit_; }
     // Springs (and bends) broken by tearing since the cloth was built (springs.tear_strain; tearing.hpp).
     std::size_t broken_springs() const { return broken_springs_; }
+    // m: the cloth's particle spacing as built, the least distance self-collision keeps (self_collision.hpp).
+    double self_collision_spacing() const { return spacing_; }
     // Changes whenever the springs or triangles change (a tear), so a renderer rebuilds its mesh.
     std::uint64_t topology_stamp() const { return topology_stamp_; }
     // How far the last substep's solve got (0 for the explicit integrators): implicit Euler's CG iterations and
@@ -172,6 +175,8 @@ private:
     // `continues`: the state is what the previous substep left (a multistep integrator may use its history).
     void step_velocity_integrator(Integrator integrator, double h, bool continues);
     void collide(StepProfile* profile);
+    // Returns whether it moved anything.
+    bool collide_self(StepProfile* profile);
     void limit_strain();
     void limit_speed(double h);
     void tear();
@@ -222,8 +227,10 @@ private:
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
+    double spacing_ = 0.0;       // m: particle_spacing() of the cloth as built
     DVec3Array rest_position_;   // m: the positions the cloth was built with (flat, at rest)
     Tethers tethers_;            // to the current pins, rebuilt when a pin is set or freed
+    std::optional<SelfCollision> self_collision_;  // built when collision.self is first on
     std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
     double last_residual_ = 0.0;

@@ -172,6 +172,14 @@ struct ColliderSettings {
     bool operator==(const ColliderSettings&) const = default;
 };
 
+// Self-collision (self_collision.hpp): the cloth's layers are kept at least the contact distance apart.
+struct CollisionSettings {
+    bool self = false;
+    float self_thickness = 0.0f;  // m: the contact distance; it is never less than the particle spacing (0: the spacing)
+    float self_friction = 0.3f;   // Coulomb friction between layers
+    bool operator==(const CollisionSettings&) const = default;
+};
+
 inline constexpr int kMaxSubsteps = 10000;  // the largest integration.substeps a scene may hold
 
 struct IntegrationSettings {
@@ -197,6 +205,7 @@ struct SimulationSettings {
     SpringSettings springs;
     ForceSettings forces;
     ColliderSettings colliders;
+    CollisionSettings collision;
     IntegrationSettings integration;
     SolverSettings solver;
     bool operator==(const SimulationSettings&) const = default;

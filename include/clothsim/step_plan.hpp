@@ -37,6 +37,7 @@ struct StepPlan {
     bool strain_limit = false;
     bool speed_limit = false;
     bool tear = false;       // springs.tear_strain > 0
+    bool self_collision = false;  // collision.self
     bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth
 
     bool any_springs() const { return springs[0] || springs[1] || springs[2]; }

@@ -23,6 +23,7 @@ enum class Stage {
     Cube,        // cube collisions
     Cylinder,    // cylinder collisions
     Ground,      // ground collisions
+    SelfCollision,  // the cloth against itself (collision.self; self_collision.hpp)
     Tethers,     // long-range attachments to the pins (tethers.hpp)
     StrainLimit, // Provot's strain limit
     SpeedLimit,  // the max_speed clamp
@@ -54,6 +55,8 @@ struct StepProfile {
     // whose box met the collider and were tested particle by particle, out of all blocks offered to it.
     std::array<long long, kColliderCount> blocks_tested{};
     std::array<long long, kColliderCount> blocks_offered{};
+    // Self-collision: tiles boxed, tiles sent to the narrow phase, particle pairs pushed apart.
+    long long self_tiles = 0, self_tiles_active = 0, self_contacts = 0;
     long long substeps = 0;         // substeps stepped
     long long slept_substeps = 0;   // substeps skipped because the cloth was asleep
 

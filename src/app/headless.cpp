@@ -44,6 +44,11 @@ nlohmann::json profile_json(const StepProfile& p, const std::vector<StageStatus>
             stage["blocks_tested"] = p.blocks_tested[c];
             stage["blocks_offered"] = p.blocks_offered[c];
         }
+        if (s.stage == Stage::SelfCollision) {
+            stage["tiles"] = p.self_tiles;
+            stage["tiles_in_narrow_phase"] = p.self_tiles_active;
+            stage["contacts"] = p.self_contacts;
+        }
         list.push_back(stage);
     }
     return {{"stages", list},
@@ -60,7 +65,9 @@ void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages,
         const std::size_t i = static_cast<std::size_t>(s.stage);
         if (s.runs()) {
             std::printf(" %s %.4f", std::string(stage_name(s.stage)).c_str(), steps > 0 ? p.ms[i] / double(steps) : 0.0);
-            if (collider_index(s.stage) >= 0) std::printf(" (%s)", profile_note(s, p).c_str());
+            if (collider_index(s.stage) >= 0 || s.stage == Stage::SelfCollision) {
+                std::printf(" (%s)", profile_note(s, p).c_str());
+            }
             std::printf(";");
         } else {
             std::string& list = s.state == StageState::Skipped ? skipped : fused;

@@ -37,6 +37,8 @@ constexpr SliderHint kHints[] = {
     {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
     {"solver.sleep_time", 0.0f, 10.0f, false}, {"colliders.contact_stiffness", 10.0f, 1e6f, true},
     {"material.density", 0.01f, 2.0f, true},  {"material.shear", 0.0f, 1e5f, true},
+    {"collision.self_thickness", 0.0f, 0.1f, false}, {"collision.self_friction", 0.0f, 2.0f, false},
+    {"springs.tear_strain", 0.0f, 2.0f, false},
 };
 
 const SliderHint* hint_for(std::string_view name) {
@@ -524,6 +526,16 @@ void colliders_section(Scene& edit, AppState& app) {
     const ColliderSettings& c = edit.settings.colliders;
     if (c.contact == ContactModel::Penalty && !(c.thickness > 0.0f)) {
         ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.3f, 1.0f), "penalty contact needs thickness > 0: no contact now");
+    }
+    ImGui::Separator();
+    ImGui::TextDisabled("self-collision");
+    fields_section(edit, app, "collision.");
+    if (edit.settings.collision.self) {
+        const double spacing = app.sim.self_collision_spacing();
+        const float thickness = edit.settings.collision.self_thickness;
+        if (thickness < spacing) {
+            ImGui::TextDisabled("layers kept %.3g mm apart (the particle spacing)", 1e3 * spacing);
+        }
     }
 }
 

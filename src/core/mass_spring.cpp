@@ -62,6 +62,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     build_fast_solver();
     blocks_.start = block_starts(n, topology_.rows, topology_.cols);
     rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
+    spacing_ = particle_spacing(topology_);
     tethers_ = build_tethers(topology_, state_, rest_position_);
     replan();
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
@@ -150,7 +151,8 @@ void MassSpring::step() {
         } break;
     }
     collide(profile);
-    if (plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
+    const bool self_moved = plan_.self_collision && collide_self(profile);
+    if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
             tethers_at_limit_ = project_tethers(state_, tethers_, settings_.springs.tether_strain);
@@ -164,7 +166,7 @@ void MassSpring::step() {
             limit_speed(h);
         }
         blocks_.current = blocks_.boxes_current = false;
-        collide(profile);  // a correction must not leave a particle inside a collider
+        collide(profile);  // a push or a correction must not leave a particle inside a collider
     }
     state_.time += h;
     ++profile_.substeps;
@@ -224,6 +226,19 @@ void MassSpring::collide(StepProfile* profile) {
     collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
 }
 
+// The cloth against itself (self_collision.hpp), built the first time it runs.
+bool MassSpring::collide_self(StepProfile* profile) {
+    StageTimer timer(profile, Stage::SelfCollision);
+    if (!self_collision_) self_collision_.emplace(topology_, rest_position_);
+    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_);
+    if (profile) {
+        profile->self_tiles += counts.tiles;
+        profile->self_tiles_active += counts.tiles_active;
+        profile->self_contacts += counts.contacts;
+    }
+    return counts.contacts > 0 || counts.clamped > 0;
+}
+
 // Springs beyond tear_strain break (tearing.hpp). The rest follows the new topology at the point of change:
 // the fast solver's layout, the projective matrix, the tethers (a piece torn off is no longer held by the
 // pins it hung from), the plan, and the stamps the renderer and the stability limit watch.
@@ -233,6 +248,7 @@ void MassSpring::tear() {
     broken_springs_ += removed;
     build_fast_solver();
     iterative_.invalidate_matrix();
+    if (self_collision_) self_collision_->update_neighbours(topology_);
     rebuild_tethers();
     replan();
     setup_stamp_ = next_stamp();

@@ -80,6 +80,10 @@ const std::array kFields = {
     FieldInfo{"colliders.contact", "", 0, 0, "projection: particles are moved out of the thickness shell after each substep, with Coulomb friction and continuous collision; penalty: a smooth force contact_stiffness x depth^3 / thickness^2 pushes them out (frictionless: friction is ignored; no continuous collision; thickness > 0)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact; }},
     FieldInfo{"colliders.contact_stiffness", "N/m", 1, 1e9, "penalty contact's k_c: the push at depth = thickness is k_c x thickness (unused by projection)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact_stiffness; }},
 
+    FieldInfo{"collision.self", "", 0, 0, "keep the cloth's layers apart: particles that share no spring stay collision.self_thickness apart (self_collision.hpp)", [](Scene& s) -> FieldRef { return &s.settings.collision.self; }},
+    FieldInfo{"collision.self_thickness", "m", 0, 1, "distance kept between layers; never less than the particle spacing (0 = the spacing), which keeps layers from passing between particles", [](Scene& s) -> FieldRef { return &s.settings.collision.self_thickness; }},
+    FieldInfo{"collision.self_friction", "", 0, 10, "Coulomb friction between layers in contact", [](Scene& s) -> FieldRef { return &s.settings.collision.self_friction; }},
+
     FieldInfo{"integration.dt", "s", 1e-7, 1, "one step (an app frame); each substep advances dt / substeps", [](Scene& s) -> FieldRef { return &s.settings.integration.dt; }},
     FieldInfo{"integration.substeps", "", 1, kMaxSubsteps, "integration substeps per step", [](Scene& s) -> FieldRef { return &s.settings.integration.substeps; }},
     FieldInfo{"integration.integrator", "", 0, 0, "time integrator (orders: verlet 2, symplectic-euler 1, rk4 4, implicit-euler 1, projective 2 (BDF2 by quasi-Newton on a prefactorised matrix; stable at any step); xpbd tends to the spring model as substeps grow)", [](Scene& s) -> FieldRef { return &s.settings.integration.integrator; }},

@@ -17,6 +17,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Cube: return "cube";
         case Stage::Cylinder: return "cylinder";
         case Stage::Ground: return "ground";
+        case Stage::SelfCollision: return "self collision";
         case Stage::Tethers: return "tethers";
         case Stage::StrainLimit: return "strain limit";
         case Stage::Tear: return "tear";
@@ -36,6 +37,9 @@ void StepProfile::add(const StepProfile& other) {
         blocks_tested[i] += other.blocks_tested[i];
         blocks_offered[i] += other.blocks_offered[i];
     }
+    self_tiles += other.self_tiles;
+    self_tiles_active += other.self_tiles_active;
+    self_contacts += other.self_contacts;
     substeps += other.substeps;
     slept_substeps += other.slept_substeps;
 }
@@ -73,6 +77,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
     plan.speed_limit = settings.forces.max_speed > 0.0f;
     plan.tear = settings.springs.tear_strain > 0.0f;
+    plan.self_collision = settings.collision.self;
     plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
     return plan;
 }
@@ -162,6 +167,8 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     collider(Stage::Cube, plan.cube, c.cube.enabled, "colliders.cube.enabled is false");
     collider(Stage::Cylinder, plan.cylinder, c.cylinder.enabled, "colliders.cylinder.enabled is false");
     collider(Stage::Ground, plan.ground, c.ground.enabled, "colliders.ground.enabled is false");
+    out.push_back({Stage::SelfCollision, when(plan.self_collision, Skipped),
+                   plan.self_collision ? "tiles boxed; pairs within the thickness pushed apart" : "collision.self is false"});
     out.push_back({Stage::Tethers, when(plan.tethers, Skipped),
                    plan.tethers ? "" : (settings.springs.tether_strain > 0.0f ? "no pins to tie to" : "springs.tether_strain is 0")});
     out.push_back({Stage::StrainLimit, when(plan.strain_limit, Skipped), plan.strain_limit ? "" : "springs.strain_limit is 0"});
@@ -175,6 +182,10 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
 }
 
 std::string profile_note(const StageStatus& status, const StepProfile& profile) {
+    if (status.stage == Stage::SelfCollision && status.runs() && profile.self_tiles > 0) {
+        return std::to_string(profile.self_tiles_active) + " of " + std::to_string(profile.self_tiles) +
+               " tiles in the narrow phase, " + std::to_string(profile.self_contacts) + " contacts";
+    }
     const int c = collider_index(status.stage);
     if (c < 0 || !status.runs() || profile.blocks_offered[c] == 0) return status.note;
     return std::to_string(profile.blocks_tested[c]) + " of " + std::to_string(profile.blocks_offered[c]) +

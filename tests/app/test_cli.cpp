@@ -190,7 +190,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 15);
+    CHECK(stage.size() == 16);
     // drape-sphere: fast solver, sphere and ground, no wind, no cube, no cylinder, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 109);
@@ -544,8 +544,8 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CAPTURE_RUN(r);
     CHECK(r.code == 0);
     CHECK(lines_of(r.out) ==
-          std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "hanging",
-                                   "stiff-drape", "stiff-hanging", "tear"});
+          std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "fold",
+                                   "hanging", "pile", "stiff-drape", "stiff-hanging", "tear"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

@@ -1,0 +1,219 @@
+// Self-collision (self_collision.hpp): layers of one cloth stay apart and never cross.
+#include "support.hpp"
+
+#include "clothsim/scene.hpp"
+#include "clothsim/self_collision.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+using namespace clothsim;
+
+namespace {
+
+// The smallest distance between two present particles that share no spring or bend, over all pairs
+// (a uniform grid of cell `reach` finds every pair closer than reach).
+double closest_strangers(const MassSpring& sim, const SelfCollision& springs_of, double reach) {
+    const State& s = sim.state();
+    const std::size_t n = s.size();
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    auto key = [&](std::size_t i) { return std::floor(s.position.x[i] / reach); };
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t u = 0; u < n; ++u) {
+        const std::size_t i = order[u];
+        if (s.pinned[i] == kAbsent) continue;
+        for (std::size_t v = u + 1; v < n && key(order[v]) <= key(i) + 1; ++v) {
+            const std::size_t j = order[v];
+            if (s.pinned[j] == kAbsent) continue;
+            if (springs_of.neighbours(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j))) continue;
+            best = std::min(best, glm::length(s.position.get(i) - s.position.get(j)));
+        }
+    }
+    return best;
+}
+
+// Whether segment pq crosses triangle abc (touching counts), in double: the segment's ends lie on opposite
+// sides of the triangle's plane (or on it), and the point where it meets the plane lies inside the triangle
+// (barycentric coordinates, all >= 0). Locating the point, rather than testing the line's orientation
+// against the edges, stays right for a segment nearly in the plane (a flat sheet whose float positions are
+// off the plane by rounding): the point is then on the segment, inside the triangle only if they overlap.
+bool segment_hits_triangle(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& a, const glm::dvec3& b,
+                           const glm::dvec3& c) {
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double sp = glm::dot(n, p - a), sq = glm::dot(n, q - a);
+    if ((sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) || (sp == 0.0 && sq == 0.0)) return false;
+    const glm::dvec3 x = p + (sp / (sp - sq)) * (q - p);
+    const double la = glm::dot(glm::cross(b - x, c - x), n), lb = glm::dot(glm::cross(c - x, a - x), n),
+                 lc = glm::dot(glm::cross(a - x, b - x), n);
+    return la >= 0.0 && lb >= 0.0 && lc >= 0.0;
+}
+
+// Two triangles that share no vertex intersect when an edge of one crosses the other.
+bool triangles_intersect(const std::array<glm::dvec3, 3>& t, const std::array<glm::dvec3, 3>& u) {
+    for (int e = 0; e < 3; ++e) {
+        if (segment_hits_triangle(t[e], t[(e + 1) % 3], u[0], u[1], u[2])) return true;
+        if (segment_hits_triangle(u[e], u[(e + 1) % 3], t[0], t[1], t[2])) return true;
+    }
+    return false;
+}
+
+// Pairs of triangles with no shared vertex that intersect, at the positions the renderer draws (float),
+// among those whose vertices are at least `apart` rows or columns apart on the grid (0: all).
+std::size_t intersecting_triangles(const MassSpring& sim, int apart = 0) {
+    const int cols = sim.topology().cols;
+    const auto& tris = sim.topology().triangles;
+    const std::size_t m = tris.size();
+    std::vector<std::array<glm::dvec3, 3>> corner(m);
+    std::vector<glm::dvec3> lo(m), hi(m);
+    for (std::size_t k = 0; k < m; ++k) {
+        for (int v = 0; v < 3; ++v) corner[k][v] = glm::dvec3(sim.position(tris[k][v]));
+        lo[k] = glm::min(corner[k][0], glm::min(corner[k][1], corner[k][2]));
+        hi[k] = glm::max(corner[k][0], glm::max(corner[k][1], corner[k][2]));
+    }
+    std::vector<std::size_t> order(m);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo[a].x < lo[b].x; });
+    std::size_t count = 0;
+    for (std::size_t u = 0; u < m; ++u) {
+        const std::size_t a = order[u];
+        for (std::size_t v = u + 1; v < m && lo[order[v]].x <= hi[a].x; ++v) {
+            const std::size_t b = order[v];
+            if (lo[b].y > hi[a].y || lo[a].y > hi[b].y || lo[b].z > hi[a].z || lo[a].z > hi[b].z) continue;
+            bool shared = false;
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) shared = shared || tris[a][i] == tris[b][j];
+            }
+            int separation = 1 << 30;
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) {
+                    const int ra = static_cast<int>(tris[a][i]) / cols, ca = static_cast<int>(tris[a][i]) % cols;
+                    const int rb = static_cast<int>(tris[b][j]) / cols, cb = static_cast<int>(tris[b][j]) % cols;
+                    separation = std::min(separation, std::max(std::abs(ra - rb), std::abs(ca - cb)));
+                }
+            }
+            if (!shared && separation >= apart && triangles_intersect(corner[a], corner[b])) ++count;
+        }
+    }
+    return count;
+}
+
+}  // namespace
+
+// Layers are triangles three or more rows or columns apart on the grid: those never cross. Triangles one or
+// two apart can, in a crease sharper than the grid resolves (their particles still keep the distance);
+// docs/SELF_COLLISION.md has the counts.
+constexpr int kLayersApart = 3;
+
+TEST_CASE("self-collision: pile and fold keep every pair of strangers half the thickness apart and no layers cross, every step",
+          "[self-collision]") {
+    for (const char* name : {"pile", "fold"}) {
+        Scene scene = load_scene(name);
+        REQUIRE(scene.settings.collision.self);
+        MassSpring sim = build_simulation(scene);
+        const SelfCollision springs_of(sim.topology(), sim.state().position);
+        const double d = springs_of.contact_distance(sim.settings().collision);
+        double closest = std::numeric_limits<double>::infinity();
+        std::size_t crossings = 0;
+        for (int step = 0; step < 150; ++step) {  // 2.5 s: falls, folds, settles
+            sim.run_steps(1);
+            REQUIRE(sim.all_finite());
+            closest = std::min(closest, closest_strangers(sim, springs_of, d));
+            crossings += intersecting_triangles(sim, kLayersApart);
+        }
+        const long long contacts = sim.profile().self_contacts;
+        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, " << contacts
+                  << " contacts");
+        CHECK(contacts > 1000);  // the layers really met
+        CHECK(closest >= 0.5 * d);
+        CHECK(crossings == 0);
+    }
+}
+
+TEST_CASE("self-collision: without it the same pile passes through itself", "[self-collision]") {
+    // The checks above are not vacuous: with collision.self off, layers of `pile` come closer than half the
+    // thickness and cross.
+    Scene scene = load_scene("pile");
+    scene.settings.collision.self = false;
+    MassSpring sim = build_simulation(scene);
+    const SelfCollision springs_of(sim.topology(), sim.state().position);
+    const double d = springs_of.contact_distance(CollisionSettings{});
+    double closest = std::numeric_limits<double>::infinity();
+    std::size_t crossings = 0;
+    for (int step = 0; step < 150; ++step) {
+        sim.run_steps(1);
+        closest = std::min(closest, closest_strangers(sim, springs_of, d));
+        crossings += intersecting_triangles(sim, kLayersApart);
+    }
+    CHECK(closest < 0.5 * d);
+    CHECK(crossings > 0);
+}
+
+TEST_CASE("self-collision: two approaching strangers are pushed to the distance, their approach removed, momentum kept",
+          "[self-collision]") {
+    // The ends of a 13-particle chain (tiles of four particles: the ends are three tiles apart) meet head-on.
+    Scene s = test::chain(13, 0.1f, 0.01f, 0.0f);
+    s.settings.collision.self = true;
+    s.settings.collision.self_thickness = 0.15f;
+    s.settings.collision.self_friction = 0.0f;
+    s.settings.solver.sleep_speed = 0.0f;
+    MassSpring sim = build_simulation(s);
+    REQUIRE_FALSE(SelfCollision(sim.topology(), sim.state().position).neighbours(0, 12));
+    const double d = 0.15;
+    // Put 12 just beside 0 and set the two moving towards each other.
+    sim.set_particle(12, sim.position(0) + glm::vec3(0.9f * static_cast<float>(d), 0.0f, 0.0f), glm::vec3(-0.5f, 0.0f, 0.0f));
+    sim.set_particle(0, sim.position(0), glm::vec3(0.5f, 0.0f, 0.0f));
+    const glm::vec3 before = sim.momentum();
+    sim.step();
+    const double gap = glm::length(sim.state().position.get(12) - sim.state().position.get(0));
+    CHECK(gap == Approx(d).epsilon(1e-6));
+    const glm::dvec3 approach = sim.state().motion.get(12) - sim.state().motion.get(0);
+    CHECK(approach.x >= -1e-15);  // no longer closing
+    CHECK(sim.profile().self_contacts == 1);
+    CHECK(glm::length(sim.momentum() - before) < 1e-6f);
+}
+
+TEST_CASE("self-collision: a flat cloth costs a box test and steps bit-identically to one without it", "[self-collision]") {
+    Scene scene = load_scene("falling");
+    scene.settings.collision.self = false;
+    MassSpring plain = build_simulation(scene);
+    scene.settings.collision.self = true;
+    MassSpring with = build_simulation(scene);
+    plain.run_steps(20);  // falling, flat, before it lands
+    with.run_steps(20);
+    CHECK(test::bit_identical(plain, with));
+    CHECK(with.profile().self_tiles > 0);
+    CHECK(with.profile().self_tiles_active == 0);
+    CHECK(with.profile().self_contacts == 0);
+}
+
+TEST_CASE("self-collision: the contact distance is the thickness, never less than the particle spacing", "[self-collision]") {
+    Scene scene = load_scene("pile");
+    MassSpring sim = build_simulation(scene);
+    const SelfCollision self(sim.topology(), sim.state().position);
+    CollisionSettings c;
+    c.self_thickness = 0.0f;
+    CHECK(self.contact_distance(c) == Approx(1.0 / 31.0));
+    c.self_thickness = 0.01f;
+    CHECK(self.contact_distance(c) == Approx(1.0 / 31.0));
+    c.self_thickness = 0.05f;
+    CHECK(self.contact_distance(c) == Approx(0.05));
+}
+
+TEST_CASE("self-collision: off by default, and the plan says so", "[self-collision]") {
+    MassSpring sim = build_simulation(load_scene("hanging"));
+    CHECK_FALSE(sim.plan().self_collision);
+    bool said = false;
+    for (const StageStatus& st : describe(sim.plan(), sim.topology(), sim.settings())) {
+        if (st.stage == Stage::SelfCollision) said = !st.runs() && st.note == "collision.self is false";
+    }
+    CHECK(said);
+}

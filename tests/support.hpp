@@ -95,9 +95,13 @@ struct CostlyScene {
     int loop_side;      // particles per side in the simulation loops
     int render_frames;  // frames drawn by the render test
 };
-inline constexpr std::array<CostlyScene, 2> kCostlyScenes = {{
+// pile and fold run self-collision, which costs several times their step (docs/SELF_COLLISION.md); their
+// own test (tests/core/test_self_collision.cpp) runs them at full size.
+inline constexpr std::array<CostlyScene, 4> kCostlyScenes = {{
     {"stiff-drape", 24, 10},
     {"stiff-hanging", 24, 10},
+    {"pile", 16, 30},
+    {"fold", 16, 30},
 }};
 
 inline const CostlyScene* costly_scene(std::string_view scene) {

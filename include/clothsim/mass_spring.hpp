@@ -33,6 +33,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -155,6 +156,10 @@ public:
     // N: the grab's force on the grabbed particle at the current state (0 without a grab), and its cap.
     glm::vec3 grab_force() const;
     float grab_force_limit() const { return grab_ ? grab_->force_limit : 0.0f; }
+    // A cut (the app's shift + right-drag): breaks every spring for which crosses(position a, position b) is
+    // true, with the bends, bending springs and triangles that bridge it, as a tear does (tearing.hpp), and
+    // wakes the cloth. Returns how many springs (bends included) broke.
+    std::size_t cut(const std::function<bool(glm::vec3, glm::vec3)>& crosses);
     // Moves a particle and gives it a velocity (for tests and tools); others keep theirs.
     void set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity);
 
@@ -180,6 +185,8 @@ private:
     void limit_strain();
     void limit_speed(double h);
     void tear();
+    // After springs broke: everything that follows the topology, at the point of change.
+    void topology_changed(std::size_t removed);
     void rebuild_tethers();
     void build_fast_solver();
     void check_sleep(double h);

@@ -15,15 +15,24 @@
 //    Minute Physics clamps velocity), so two layers close by at most d / 2 between two checks, less than
 //    the slab they must cross.
 //
-// Broad phase: the grid is cut into tiles of kSelfTile x kSelfTile particles. Each substep boxes every tile
-// and sweeps the boxes along x (kept sorted from substep to substep, so the sort is nearly free); when no
-// two tiles that are not grid neighbours come within d, and no tile or pair of neighbouring tiles is
-// folded (its box diagonal under 0.9 of its rest diagonal), nothing else runs (tested with a reach of
-// d + (kSelfSkip - 1) d / 2, an empty test also covers the next kSelfSkip - 1 substeps, since no particle
-// moves more than d / 4 a substep: the stage then costs the motion clamp alone). Otherwise the narrow phase
-// tests every particle pair of those tile pairs, and of each such tile with itself and its grid
-// neighbours (where a fold between far tiles turns). The pairs within d are resolved in index order
-// (Gauss-Seidel, one pass a substep), so the result does not depend on the order the tiles came in.
+// Broad phase: the grid is cut into tiles of kSelfTile x kSelfTile particles. Each test boxes every tile and
+// sweeps the boxes along x (kept sorted from test to test, so the sort is nearly free). Two kinds of tile
+// go to the narrow phase:
+//  - far pairs: tiles that are not grid neighbours and come within d of each other (layers meeting);
+//  - folded tiles, with themselves and their neighbours (a fold or buckle shorter than two tiles): a tile
+//    whose vector area (the cross product of its corner diagonals) falls under half its rest value, two
+//    neighbours whose mean normals point apart (more than 90 degrees: a hairpin; Volino &
+//    Magnenat-Thalmann 1994's normal cone), or a tile alone or with a neighbour whose box diagonal falls
+//    under 0.8 of its rest diagonal (a box's diagonal is at least the distance between any two of its
+//    particles: an accordion buckle that leaves each tile's normal alone).
+// The narrow phase compares every particle of one tile with every particle of the other (16 x 16, four at
+// a time in float), keeps the pairs within d that share no spring, and resolves them in index order in
+// double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.
+// Skipping: a test that finds nothing within the reach d + (kSelfSkip - 1) d / 2 and no tile bent by more
+// than 50 degrees from a neighbour or near the thresholds above also covers the next kSelfSkip - 1
+// substeps: no particle moves more than d / 4 a substep, so no far tiles can have come within d (for the
+// fold thresholds it allows twice the fastest particle's motion a substep, a heuristic). The stage then
+// costs the motion clamp alone.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"
@@ -31,13 +40,16 @@
 #include "clothsim/state.hpp"
 
 #include <cstddef>
+#include <array>
+#include <cstdlib>
 #include <cstdint>
+#include <glm/vec3.hpp>
 #include <vector>
 
 namespace clothsim {
 
 inline constexpr int kSelfTile = 4;  // particles along each side of a broad-phase tile
-inline constexpr int kSelfSkip = 4;  // substeps one box test that finds nothing covers
+inline constexpr int kSelfSkip = 8;  // substeps one box test that finds nothing covers
 
 // The cloth's particle spacing: its longest structural rest length (0 without structural springs).
 double particle_spacing(const Topology& topology);
@@ -70,31 +82,48 @@ public:
     bool neighbours(std::uint32_t i, std::uint32_t j) const;
 
 private:
+    struct TilePoints {
+        float x[kSelfTile * kSelfTile], y[kSelfTile * kSelfTile], z[kSelfTile * kSelfTile];
+        std::uint32_t index[kSelfTile * kSelfTile];
+        int row[kSelfTile * kSelfTile], col[kSelfTile * kSelfTile];
+        int count = 0;
+    };
+
     int tile_rows_ = 0, tile_cols_ = 0;     // tiles of the grid (rows x cols), or one row of runs
     bool grid_ = false;                     // false: tiles are runs of kSelfTile^2 particles along the list
     int rows_ = 0, cols_ = 0;
     std::size_t particles_ = 0;
     double spacing_ = 0.0;                  // m: the longest structural rest length
     std::vector<std::uint32_t> neighbour_begin_, neighbour_;  // sorted spring neighbours of each particle
+    std::vector<std::uint32_t> near_mask_;  // grid: bit (dr + 2) * 5 + dc + 2 set for a neighbour at (dr, dc)
+    bool far_links_ = false;                // grid: some link spans more than two rows or columns
+    bool near_neighbours(std::uint32_t i, int dr, int dc) const {
+        return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((near_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
+    }
+    std::vector<int> tile_row_, tile_col_;  // each tile's place in the grid of tiles
+    std::vector<std::array<std::uint32_t, 4>> corner_;  // grid: each tile's corner particles (00, 0c, r0, rc)
+    std::vector<float> rest_area_;          // grid: twice each tile's rest area, |vector_area| as built
+    std::vector<float> tile_rest_;          // grid, per tile: rest diagonals of it alone and with 4 neighbours
     // Scratch, kept between substeps.
     std::vector<Box> boxes_;
     std::vector<std::uint32_t> order_;      // tiles sorted by box.lo.x (the last substep's order)
-    std::vector<std::uint8_t> active_;      // tiles within d of a tile that is not a grid neighbour
+    std::vector<std::uint8_t> active_;      // 1: within d of a far tile; 2: folded (tested with its neighbours)
+    std::vector<glm::vec3> normal_;         // grid: each tile's mean normal
     std::vector<std::uint64_t> tile_pairs_; // (a << 32 | b), a <= b: the tile pairs the narrow phase tests
     std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within d
-    std::vector<std::uint32_t> first_, second_;
-    std::vector<int> tile_row_, tile_col_;  // each tile's place in the grid of tiles
-    std::vector<float> tile_rest_;          // per tile: rest diagonals of it alone and with 4 neighbours
-    float d_for_reach_ = 0.0f;              // the d of the current box test
+    std::vector<TilePoints> points_;
+    std::vector<std::uint8_t> gathered_;
+    const DVec3Array* positions_ = nullptr; // during mark_active
     int substeps_to_test_ = 0;              // substeps the last empty box test still covers
     double tested_distance_ = 0.0;          // the d it was made for
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;
     void tile_boxes(const DVec3Array& position);
-    // Marks the tiles that come within `reach` of a non-adjacent tile and lists the tile pairs to test: those, and
-    // each marked tile with itself and its grid neighbours. Returns how many tiles are marked.
-    std::size_t mark_active(float reach);
-    void tile_particles(std::uint32_t t, const State& state, std::vector<std::uint32_t>& out) const;
+    // Lists the tile pairs the narrow phase tests: far tiles within d of each other, and each folded tile
+    // with itself and its neighbours. Returns 0 when nothing comes within `reach` and nothing is bent, so
+    // the next substeps may skip the test.
+    std::size_t mark_active(float d, float reach, float fold_slack);
+    void gather(std::uint32_t t, const State& state, TilePoints& out) const;
 };
 
 }  // namespace clothsim

@@ -201,6 +201,30 @@ void drag_grabbed(AppState& app, const Window& window, float scale) {
     else app.sim.grab(grab.particle, *p);
 }
 
+// Whether segments ab and cd cross on screen (strictly: touching at an end does not count).
+bool segments_cross(glm::vec2 a, glm::vec2 b, glm::vec2 c, glm::vec2 d) {
+    auto side = [](glm::vec2 p, glm::vec2 q, glm::vec2 r) {
+        const float v = (q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x);
+        return (v > 0.0f) - (v < 0.0f);
+    };
+    return side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0;
+}
+
+// Shift + right-drag cuts: the springs whose ends, as drawn, lie on either side of the stroke's last piece
+// (the cursor's move since the last frame) break, as Blender's knife cuts what the stroke crosses.
+void cut_along_stroke(AppState& app, const Window& window, float scale, glm::vec2 from, glm::vec2 to) {
+    if (from == to) return;
+    const glm::vec4 r = view_rect(app, window, scale);
+    const glm::vec2 origin(r.x, r.y), viewport(r.z, r.w);
+    const glm::vec2 a = from - origin, b = to - origin;
+    const std::size_t broken = app.sim.cut([&](glm::vec3 p, glm::vec3 q) {
+        const glm::vec3 sp = project(app.camera, p, viewport), sq = project(app.camera, q, viewport);
+        const bool visible = sp.z > 0.0f && sp.z < 1.0f && sq.z > 0.0f && sq.z < 1.0f;
+        return visible && segments_cross(a, b, glm::vec2(sp), glm::vec2(sq));
+    });
+    if (broken > 0) app.say("cut " + std::to_string(broken) + " springs");
+}
+
 void handle_mouse(AppState& app, const Window& window, float scale) {
     const ImGuiIO& io = ImGui::GetIO();
     const glm::vec2 delta(io.MouseDelta.x, io.MouseDelta.y);
@@ -215,6 +239,11 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
         return;
     }
     if (io.WantCaptureMouse) return;
+    if (io.KeyShift && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+        const glm::vec2 to(io.MousePos.x, io.MousePos.y);
+        cut_along_stroke(app, window, scale, to - delta, to);
+        return;
+    }
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift) {
         std::vector<glm::vec3> positions = app.sim.positions();
         // Slots outside the cloth's shape are not there to pick.

@@ -363,6 +363,7 @@ void help_section() {
     ImGui::TextUnformatted("Mouse");
     ImGui::BulletText("left-drag on empty space: orbit");
     ImGui::BulletText("right- or middle-drag, shift+left-drag: pan");
+    ImGui::BulletText("shift+right-drag: cut the springs the stroke crosses");
     ImGui::BulletText("wheel: zoom");
     ImGui::BulletText("left-drag on the cloth: grab a particle");
     ImGui::BulletText("ctrl+click on the cloth: pin / unpin a particle");

@@ -243,7 +243,18 @@ bool MassSpring::collide_self(StepProfile* profile) {
 // the fast solver's layout, the projective matrix, the tethers (a piece torn off is no longer held by the
 // pins it hung from), the plan, and the stamps the renderer and the stability limit watch.
 void MassSpring::tear() {
-    const std::size_t removed = tear_springs(topology_, state_.position, settings_.springs.tear_strain);
+    topology_changed(tear_springs(topology_, state_.position, settings_.springs.tear_strain));
+}
+
+std::size_t MassSpring::cut(const std::function<bool(glm::vec3, glm::vec3)>& crosses) {
+    const std::size_t removed =
+        break_springs(topology_, [&](const Spring& s) { return crosses(position(s.a), position(s.b)); });
+    topology_changed(removed);
+    if (removed > 0) wake();
+    return removed;
+}
+
+void MassSpring::topology_changed(std::size_t removed) {
     if (removed == 0) return;
     broken_springs_ += removed;
     build_fast_solver();

@@ -2,6 +2,8 @@
 
 #include <glm/geometric.hpp>
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -13,6 +15,12 @@ constexpr std::uint32_t kSelfTileParticles = kSelfTile * kSelfTile;
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
     if (a > b) std::swap(a, b);
     return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+// Twice the vector area of the quadrilateral of a tile's corners (00, 0c, r0, rc): the cross product of its
+// diagonals. Its direction is the tile's mean normal; a tile folded onto itself has almost none left.
+glm::dvec3 vector_area(const DVec3Array& position, const std::array<std::uint32_t, 4>& corner) {
+    return glm::cross(position.get(corner[3]) - position.get(corner[0]), position.get(corner[1]) - position.get(corner[2]));
 }
 
 // Whether boxes a and b come within `reach` of each other (per axis).
@@ -43,10 +51,29 @@ SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_po
     }
     spacing_ = particle_spacing(topology);
     update_neighbours(topology);
-    // The rest diagonal of each tile alone and with its neighbours to the right, below, below right and
-    // below left: the longer distance between opposite corner particles of the region.
+    const std::size_t tiles = static_cast<std::size_t>(tile_rows_) * tile_cols_;
+    order_.resize(tiles);
+    tile_row_.resize(tiles);
+    tile_col_.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t) {
+        order_[t] = static_cast<std::uint32_t>(t);
+        tile_row_[t] = static_cast<int>(t) / tile_cols_;
+        tile_col_[t] = static_cast<int>(t) % tile_cols_;
+    }
+    // Each tile's corner particles and its vector area at rest (the fold test compares against it).
     if (grid_) {
-        tile_rest_.assign(static_cast<std::size_t>(tile_rows_) * tile_cols_ * 5, 0.0f);
+        corner_.resize(tiles);
+        rest_area_.resize(tiles);
+        for (std::size_t t = 0; t < tiles; ++t) {
+            const int r0 = tile_row_[t] * kSelfTile, c0 = tile_col_[t] * kSelfTile;
+            const int r1 = std::min(rows_, r0 + kSelfTile) - 1, c1 = std::min(cols_, c0 + kSelfTile) - 1;
+            auto at = [&](int r, int c) { return static_cast<std::uint32_t>(static_cast<std::size_t>(r) * cols_ + c); };
+            corner_[t] = {at(r0, c0), at(r0, c1), at(r1, c0), at(r1, c1)};
+            rest_area_[t] = static_cast<float>(glm::length(vector_area(rest_position, corner_[t])));
+        }
+        // The rest diagonal of each tile alone and with its neighbours to the right, below, below right and
+        // below left: the longer distance between opposite corner particles of the region.
+        tile_rest_.assign(tiles * 5, 0.0f);
         auto corner = [&](int r, int c) { return rest_position.get(static_cast<std::size_t>(r) * cols_ + c); };
         auto diagonal = [&](int r0, int c0, int r1, int c1) {  // rows r0..r1, cols c0..c1 of tiles
             const int pr0 = r0 * kSelfTile, pc0 = c0 * kSelfTile;
@@ -64,15 +91,6 @@ SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_po
                 if (r + 1 < tile_rows_ && c > 0) rest[4] = diagonal(r, c - 1, r + 1, c);
             }
         }
-    }
-    const std::size_t tiles = static_cast<std::size_t>(tile_rows_) * tile_cols_;
-    order_.resize(tiles);
-    tile_row_.resize(tiles);
-    tile_col_.resize(tiles);
-    for (std::size_t t = 0; t < tiles; ++t) {
-        order_[t] = static_cast<std::uint32_t>(t);
-        tile_row_[t] = static_cast<int>(t) / tile_cols_;
-        tile_col_[t] = static_cast<int>(t) % tile_cols_;
     }
 }
 
@@ -92,6 +110,22 @@ void SelfCollision::update_neighbours(const Topology& topology) {
     std::vector<std::uint32_t> all(begin.back());
     std::vector<std::uint32_t> fill(begin.begin(), begin.end() - 1);
     each_link([&](std::uint32_t a, std::uint32_t b) { all[fill[a]++] = b, all[fill[b]++] = a; });
+    // On a grid whose links all span at most two rows and columns, each particle's neighbours also fit a
+    // 5 x 5 bit mask, tested without a search.
+    far_links_ = false;
+    near_mask_.assign(grid_ ? particles_ : 0, 0u);
+    if (grid_) {
+        each_link([&](std::uint32_t a, std::uint32_t b) {
+            const int dr = static_cast<int>(b) / cols_ - static_cast<int>(a) / cols_;
+            const int dc = static_cast<int>(b) % cols_ - static_cast<int>(a) % cols_;
+            if (std::abs(dr) > 2 || std::abs(dc) > 2) {
+                far_links_ = true;
+                return;
+            }
+            near_mask_[a] |= 1u << ((dr + 2) * 5 + (dc + 2));
+            near_mask_[b] |= 1u << ((2 - dr) * 5 + (2 - dc));
+        });
+    }
     neighbour_begin_.assign(particles_ + 1, 0);
     neighbour_.clear();
     neighbour_.reserve(all.size());
@@ -104,6 +138,11 @@ void SelfCollision::update_neighbours(const Topology& topology) {
 }
 
 bool SelfCollision::neighbours(std::uint32_t i, std::uint32_t j) const {
+    if (grid_ && !far_links_) {
+        const int dr = static_cast<int>(j) / cols_ - static_cast<int>(i) / cols_;
+        const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
+        return near_neighbours(i, dr, dc);
+    }
     const auto begin = neighbour_.begin() + neighbour_begin_[i], end = neighbour_.begin() + neighbour_begin_[i + 1];
     return std::binary_search(begin, end, j);
 }
@@ -136,9 +175,11 @@ void SelfCollision::tile_boxes(const DVec3Array& position) {
     }
 }
 
-std::size_t SelfCollision::mark_active(float reach) {
-    // Regions whose box diagonal falls below this fraction of the rest diagonal count as folded.
-    constexpr float kCrumpled = 0.9f;
+// The box test, the fold test and the narrow phase's tile pairs (see the header). `reach` is the distance
+// the far-tile test allows; `strict` says whether the result is for this substep alone (else it must also
+// cover the substeps an empty result skips, so bends count as folds sooner).
+std::size_t SelfCollision::mark_active(float d, float reach, float fold_slack) {
+    constexpr float kCrumpled = 0.8f;  // box diagonal over rest diagonal below which a region counts as folded
     const std::size_t tiles = boxes_.size();
     // Insertion sort by lo.x from the last substep's order: nearly sorted already, so nearly linear.
     for (std::size_t k = 1; k < tiles; ++k) {
@@ -150,49 +191,78 @@ std::size_t SelfCollision::mark_active(float reach) {
     }
     active_.assign(tiles, 0);
     tile_pairs_.clear();
-    for (std::size_t k = 0; k < tiles; ++k) {
-        const std::uint32_t a = order_[k];
-        if (boxes_[a].empty()) continue;
-        for (std::size_t m = k + 1; m < tiles; ++m) {
-            const std::uint32_t b = order_[m];
-            if (boxes_[b].lo.x > boxes_[a].hi.x + reach) break;
-            if (!within(boxes_[a], boxes_[b], reach) || adjacent_tiles(a, b)) continue;
-            active_[a] = active_[b] = 1;
-            tile_pairs_.push_back(pair_key(a, b));
+    // Far pairs within `within_reach` of each other: listed (and marked) when `list`, else only whether any.
+    auto sweep = [&](float within_reach, bool list) {
+        bool any = false;
+        for (std::size_t k = 0; k < tiles; ++k) {
+            const std::uint32_t a = order_[k];
+            if (boxes_[a].empty()) continue;
+            for (std::size_t m = k + 1; m < tiles; ++m) {
+                const std::uint32_t b = order_[m];
+                if (boxes_[b].lo.x > boxes_[a].hi.x + within_reach) break;
+                if (!within(boxes_[a], boxes_[b], within_reach) || adjacent_tiles(a, b)) continue;
+                if (!list) return true;
+                any = true;
+                active_[a] = active_[b] = 1;
+                tile_pairs_.push_back(pair_key(a, b));
+            }
         }
-    }
-    // A fold within a tile or between grid neighbours shrinks their box below its rest diagonal (the box's
-    // diagonal is at least the distance between any two of its particles): such tiles are marked too.
-    // Looking ahead (reach > d) the test allows the shrinking the extra reach could bring.
+        return any;
+    };
+    sweep(d, true);
+    bool near = false;  // a bend near the fold thresholds: the next substeps cannot be skipped
+    // Folds within a tile or between grid neighbours (Volino & Magnenat-Thalmann 1994: a surface whose
+    // normals all lie within a half-space cannot meet itself). A tile is folded when its vector area falls
+    // under half its rest area, two neighbours when their mean normals point apart (a hairpin). Such
+    // tiles are tested against themselves and their neighbours. Looking ahead, a tile bent by more than
+    // 50 degrees from a neighbour, or with under 0.7 of its area, already rules out skipping.
     if (grid_) {
-        const float slack = reach - d_for_reach_;
+        normal_.resize(tiles);
+        for (std::size_t t = 0; t < tiles; ++t) {
+            const glm::dvec3 area = vector_area(*positions_, corner_[t]);
+            const double length = glm::length(area);
+            normal_[t] = length > 0.0 ? glm::vec3(area / length) : glm::vec3(0.0f);
+            if (!(length >= 0.5 * rest_area_[t])) active_[t] = 2;  // also NaN
+            if (!(length >= 0.7 * rest_area_[t])) near = true;
+        }
+        // Crumpled regions: a tile, or a tile with a neighbour, whose box diagonal (at least the distance
+        // between any two of its particles) falls under 0.8 of its rest diagonal (a fold or an accordion
+        // buckle across tiles that leaves each tile's normal alone).
         auto box_diagonal = [](const Box& b) { return glm::length(b.hi - b.lo); };
         auto joined = [](const Box& a, const Box& b) { return Box{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)}; };
-        for (int r = 0; r < tile_rows_; ++r) {
-            for (int c = 0; c < tile_cols_; ++c) {
-                const std::uint32_t t = static_cast<std::uint32_t>(r * tile_cols_ + c);
-                const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
-                auto crumpled = [&](const Box& box, float rest_diagonal) {
-                    return !box.empty() && box_diagonal(box) < kCrumpled * rest_diagonal + slack;
-                };
-                if (crumpled(boxes_[t], rest[0])) active_[t] = 1;
-                const int dr[5] = {0, 0, 1, 1, 1}, dc[5] = {0, 1, 0, 1, -1};
-                for (int k = 1; k < 5; ++k) {
-                    if (rest[k] == 0.0f) continue;
-                    const std::uint32_t u = static_cast<std::uint32_t>((r + dr[k]) * tile_cols_ + (c + dc[k]));
-                    if (crumpled(joined(boxes_[t], boxes_[u]), rest[k])) active_[t] = active_[u] = 1;
-                }
+        const float slack = fold_slack;  // looking ahead: the shrinking the skipped substeps may bring
+        for (std::uint32_t t = 0; t < tiles; ++t) {
+            const int r = tile_row_[t], c = tile_col_[t];
+            const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
+            if (!boxes_[t].empty()) {
+                const float diagonal = box_diagonal(boxes_[t]);
+                if (diagonal < kCrumpled * rest[0]) active_[t] = 2;
+                if (diagonal < kCrumpled * rest[0] + slack) near = true;
+            }
+            const int dr[5] = {0, 0, 1, 1, 1}, dc[5] = {0, 1, 0, 1, -1};
+            for (int k = 1; k < 5; ++k) {
+                if (rest[k] == 0.0f) continue;
+                const std::uint32_t u = static_cast<std::uint32_t>((r + dr[k]) * tile_cols_ + (c + dc[k]));
+                const float cosine = glm::dot(normal_[t], normal_[u]);
+                if (!(cosine >= 0.0f)) active_[t] = active_[u] = 2;
+                if (!(cosine >= 0.64f)) near = true;  // cos 50 degrees
+                if (boxes_[t].empty() || boxes_[u].empty()) continue;
+                const float diagonal = box_diagonal(joined(boxes_[t], boxes_[u]));
+                if (diagonal < kCrumpled * rest[k]) active_[t] = active_[u] = 2;
+                if (diagonal < kCrumpled * rest[k] + slack) near = true;
             }
         }
     }
-    if (std::find(active_.begin(), active_.end(), std::uint8_t{1}) == active_.end()) return 0;
-    // A fold that brings two far tiles together turns in the tiles between: an active tile is also tested
-    // against itself and its grid neighbours.
+    const bool any_active = std::find_if(active_.begin(), active_.end(), [](std::uint8_t a) { return a != 0; }) != active_.end();
+    // Nothing to test now: the next substeps may be skipped unless something is near (the wider sweep last,
+    // as it costs the most).
+    if (!any_active) return near || sweep(reach, false) ? 1 : 0;
     std::size_t count = 0;
     for (std::uint32_t t = 0; t < tiles; ++t) {
-        if (!active_[t]) continue;
+        if (active_[t] == 0) continue;
         ++count;
-        const int r = static_cast<int>(t) / tile_cols_, c = static_cast<int>(t) % tile_cols_;
+        if (active_[t] != 2) continue;
+        const int r = tile_row_[t], c = tile_col_[t];
         for (int dr = -1; dr <= 1; ++dr) {
             for (int dc = -1; dc <= 1; ++dc) {
                 if (r + dr < 0 || r + dr >= tile_rows_ || c + dc < 0 || c + dc >= tile_cols_) continue;
@@ -205,20 +275,32 @@ std::size_t SelfCollision::mark_active(float reach) {
     return count;
 }
 
-// The present particles of tile t, in index order.
-void SelfCollision::tile_particles(std::uint32_t t, const State& state, std::vector<std::uint32_t>& out) const {
-    out.clear();
+// Tile t's present particles as float coordinates, padded to kSelfTileParticles with far-away points.
+void SelfCollision::gather(std::uint32_t t, const State& state, TilePoints& out) const {
+    int n = 0;
     auto add = [&](std::size_t i) {
-        if (state.pinned[i] != kAbsent) out.push_back(static_cast<std::uint32_t>(i));
+        if (state.pinned[i] == kAbsent) return;
+        out.index[n] = static_cast<std::uint32_t>(i);
+        out.row[n] = grid_ ? static_cast<int>(i) / cols_ : 0;
+        out.col[n] = grid_ ? static_cast<int>(i) % cols_ : 0;
+        out.x[n] = static_cast<float>(state.position.x[i]);
+        out.y[n] = static_cast<float>(state.position.y[i]);
+        out.z[n] = static_cast<float>(state.position.z[i]);
+        ++n;
     };
     if (!grid_) {
         const std::size_t begin = static_cast<std::size_t>(t) * kSelfTileParticles;
         for (std::size_t i = begin; i < std::min(particles_, begin + kSelfTileParticles); ++i) add(i);
-        return;
+    } else {
+        const int r0 = tile_row_[t] * kSelfTile, c0 = tile_col_[t] * kSelfTile;
+        for (int r = r0; r < std::min(rows_, r0 + kSelfTile); ++r) {
+            for (int c = c0; c < std::min(cols_, c0 + kSelfTile); ++c) add(static_cast<std::size_t>(r) * cols_ + c);
+        }
     }
-    const int r0 = static_cast<int>(t) / tile_cols_ * kSelfTile, c0 = static_cast<int>(t) % tile_cols_ * kSelfTile;
-    for (int r = r0; r < std::min(rows_, r0 + kSelfTile); ++r) {
-        for (int c = c0; c < std::min(cols_, c0 + kSelfTile); ++c) add(static_cast<std::size_t>(r) * cols_ + c);
+    out.count = n;
+    for (; n < static_cast<int>(kSelfTileParticles); ++n) {
+        out.index[n] = 0;
+        out.x[n] = out.y[n] = out.z[n] = 1e30f;  // its squared distance to anything is inf: never a candidate
     }
 }
 
@@ -247,44 +329,66 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
         ++counts.clamped;
     }
 
-    // The box test. After one that found no tiles within reach of each other, the next kSelfSkip - 1
-    // substeps need none: tested with reach d + (kSelfSkip - 1) d / 2, no two far tiles can have come
-    // within d since (each substep closes at most d / 2).
+    // An empty test covers kSelfSkip substeps: made with the reach d + (kSelfSkip - 1) d / 2, no two far
+    // tiles can have come within d since (each substep closes at most d / 2).
     if (substeps_to_test_ > 0 && tested_distance_ == d) {
         --substeps_to_test_;
         return counts;
     }
     tile_boxes(state.position);
     counts.tiles = static_cast<long long>(boxes_.size());
-    const double reach = d + 0.5 * (kSelfSkip - 1) * d;
-    d_for_reach_ = static_cast<float>(d);
-    if (mark_active(static_cast<float>(reach)) == 0) {
+    positions_ = &state.position;
+    // Folds form from the cloth's own motion: a region shrinks by at most twice its particles' motion a
+    // substep, taken as twice the fastest particle's now (the motion may grow over the skipped substeps).
+    const double fold_slack = 2.0 * (kSelfSkip - 1) * 2.0 * std::min(std::sqrt(fastest2), longest);
+    const std::size_t marked = mark_active(static_cast<float>(d), static_cast<float>(d + 0.5 * (kSelfSkip - 1) * d),
+                                           static_cast<float>(fold_slack));
+    positions_ = nullptr;
+    if (marked == 0) {
         substeps_to_test_ = kSelfSkip - 1;
         tested_distance_ = d;
         return counts;
     }
-    counts.tiles_active = static_cast<long long>(mark_active(static_cast<float>(d)));
-    if (counts.tiles_active == 0) return counts;
+    if (tile_pairs_.empty()) return counts;
 
-    // Candidate pairs: within d at the current positions, from each tile pair once (so each particle pair at
-    // most once), then resolved in (i, j) order whatever order the tiles came in.
-    const double d2 = d * d;
+    // Candidate pairs: within d (in float, with a margin the double test below decides) from each tile pair
+    // once, so each particle pair at most once; resolved in (i, j) order whatever order the tiles came in.
+    const float reach2 = static_cast<float>(1.001 * d * d);
     candidates_.clear();
+    points_.resize(boxes_.size());
+    gathered_.assign(boxes_.size(), 0);
     for (const std::uint64_t key : tile_pairs_) {
         const auto a = static_cast<std::uint32_t>(key >> 32), b = static_cast<std::uint32_t>(key);
-        tile_particles(a, state, first_);
-        tile_particles(b, state, second_);
-        for (std::size_t u = 0; u < first_.size(); ++u) {
-            const std::uint32_t i = first_[u];
-            const double px = state.position.x[i], py = state.position.y[i], pz = state.position.z[i];
-            for (std::size_t v = a == b ? u + 1 : 0; v < second_.size(); ++v) {
-                const std::uint32_t j = second_[v];
-                const double vx = state.position.x[j] - px, vy = state.position.y[j] - py, vz = state.position.z[j] - pz;
-                if (vx * vx + vy * vy + vz * vz < d2 && !neighbours(i, j)) candidates_.push_back(pair_key(i, j));
+        for (const std::uint32_t t : {a, b}) {
+            if (!gathered_[t]) gather(t, state, points_[t]), gathered_[t] = 1;
+        }
+        const TilePoints& A = points_[a];
+        const TilePoints& B = points_[b];
+        for (int u = 0; u < A.count; ++u) {
+            // Squared distances from A's particle u to all of B's, four at a time (SSE2, the x86-64 baseline).
+            const __m128 px = _mm_set1_ps(A.x[u]), py = _mm_set1_ps(A.y[u]), pz = _mm_set1_ps(A.z[u]);
+            const __m128 limit = _mm_set1_ps(reach2);
+            unsigned close = 0;
+            for (int v = 0; v < static_cast<int>(kSelfTileParticles); v += 4) {
+                const __m128 dx = _mm_sub_ps(_mm_loadu_ps(B.x + v), px);
+                const __m128 dy = _mm_sub_ps(_mm_loadu_ps(B.y + v), py);
+                const __m128 dz = _mm_sub_ps(_mm_loadu_ps(B.z + v), pz);
+                const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+                close |= static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(r2, limit))) << v;
+            }
+            if (a == b) close &= ~((2u << u) - 1u);  // within one tile: each pair once, not with itself
+            while (close != 0) {
+                const int v = __builtin_ctz(close);
+                close &= close - 1;
+                const std::uint32_t i = A.index[u], j = B.index[v];
+                const bool linked = grid_ && !far_links_ ? near_neighbours(i, B.row[v] - A.row[u], B.col[v] - A.col[u])
+                                                         : neighbours(i, j);
+                if (!linked) candidates_.push_back(pair_key(i, j));
             }
         }
     }
     std::sort(candidates_.begin(), candidates_.end());
+    counts.tiles_active = static_cast<long long>(std::count(gathered_.begin(), gathered_.end(), std::uint8_t{1}));
 
     for (const std::uint64_t key : candidates_) {
         const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);

@@ -25,23 +25,26 @@ std::uint32_t middle(const Topology& t, std::uint32_t a, std::uint32_t b) {
 }  // namespace
 
 std::size_t tear_springs(Topology& topology, const DVec3Array& position, float tear_strain) {
-    std::unordered_set<std::uint64_t> broken;
-    auto over = [&](const Spring& s) {
+    return break_springs(topology, [&](const Spring& s) {
         if (s.rest_length <= 0.0f) return false;
         const double length = glm::length(position.get(s.b) - position.get(s.a));
         return length > (1.0 + double(tear_strain)) * s.rest_length;  // false for NaN
-    };
+    });
+}
+
+std::size_t break_springs(Topology& topology, const std::function<bool(const Spring&)>& breaks) {
+    std::unordered_set<std::uint64_t> broken;
     for (const Spring& s : topology.springs) {
-        if (s.kind != SpringKind::Bending && over(s)) broken.insert(pair_key(s.a, s.b));
+        if (s.kind != SpringKind::Bending && breaks(s)) broken.insert(pair_key(s.a, s.b));
     }
-    // Skip-one bending springs break on their own strain, or with a segment they span.
+    // Skip-one bending springs break on their own account, or with a segment they span.
     auto bridges = [&](std::uint32_t a, std::uint32_t m, std::uint32_t b) {
         return broken.count(pair_key(a, m)) != 0 || broken.count(pair_key(m, b)) != 0;
     };
     const std::size_t before = topology.springs.size() + topology.bends.size();
     std::erase_if(topology.springs, [&](const Spring& s) {
         if (s.kind != SpringKind::Bending) return broken.count(pair_key(s.a, s.b)) != 0;
-        return over(s) || (topology.cols > 0 && bridges(s.a, middle(topology, s.a, s.b), s.b));
+        return breaks(s) || (topology.cols > 0 && bridges(s.a, middle(topology, s.a, s.b), s.b));
     });
     std::erase_if(topology.bends, [&](const Bend& b) { return bridges(b.a, b.m, b.b); });
     const std::size_t removed = before - topology.springs.size() - topology.bends.size();

@@ -215,6 +215,42 @@ TEST_CASE("user session: a hard, fast drag on curtain pulls the cloth without th
     CHECK_THAT(r.err, !Contains("guard"));  // the app's errors go to stderr too
 }
 
+TEST_CASE("user session: shift + right-drag across the paused curtain cuts it, and played on, the part below falls away") {
+    const clothsim::Scene scene = clothsim::load_scene("curtain");
+    const int cols = scene.cloth.cols;
+    auto on_screen = [&](int row, int col) { return particle_on_screen(scene, static_cast<std::size_t>(row * cols + col)); };
+    // The stroke runs between rows 19 and 20, from left of the curtain to right of it.
+    const glm::vec3 left = 0.5f * (on_screen(19, 0) + on_screen(20, 0)), right = 0.5f * (on_screen(19, cols - 1) + on_screen(20, cols - 1));
+    const glm::vec3 below = on_screen(34, cols / 2), above = on_screen(4, cols / 2);
+    const TempDir dir("session_cut");
+    const RunResult r = run_user_session(
+        dir, {"--scene", "curtain", "--paused", "--view", "no-texture"},
+        "shot before.png\ncut " + std::to_string(int(left.x) - 30) + " " + std::to_string(int(left.y)) + " " +
+            std::to_string(int(right.x) + 30) + " " + std::to_string(int(right.y)) +
+            "\nkey space\nsleep 2\nshot after.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const Image before = load_png(dir / "before.png"), after = load_png(dir / "after.png");
+    REQUIRE(before.width == kWidth);
+    REQUIRE(after.width == kWidth);
+    // Untextured, the cloth is salmon (red well above blue); the ground and the sky are grey or blue.
+    auto cloth_at = [](const Image& image, glm::vec3 p) {
+        int cloth = 0;
+        for (int dy = -2; dy <= 2; ++dy) {
+            for (int dx = -2; dx <= 2; ++dx) {
+                const Rgb c = image.at(int(p.x) + dx, int(p.y) + dy);
+                cloth += c.r - c.b > 40 ? 1 : 0;
+            }
+        }
+        return cloth > 20;  // of 25 pixels
+    };
+    CHECK(cloth_at(before, below));
+    CHECK(cloth_at(before, above));
+    CHECK_FALSE(cloth_at(after, below));  // the part below the cut fell away
+    CHECK(cloth_at(after, above));        // the part above still hangs from its pins
+    CHECK_THAT(r.err, !Contains("guard"));
+}
+
 TEST_CASE("user session: typed out-of-range values are clamped with a note, and Save writes a file Open accepts") {
     const TempDir dir("session_typed");
     // Forces open; wind speed typed 1e9 (allowed |wind| components up to 1e4), damping typed 1e9.

@@ -19,6 +19,7 @@ namespace clothsim::test {
 //   click X Y            left click at window coordinates (pixels from the top-left)
 //   ctrl_click X Y       the same with Ctrl held
 //   drag X0 Y0 X1 Y1     left button down at (X0, Y0), moved to (X1, Y1), released
+//   cut X0 Y0 X1 Y1      the same with the right button and Shift held (the knife)
 //   shot NAME            an F12 screenshot, saved as NAME (a PNG in the session's directory)
 //   settle               waits for a few frames to be drawn
 //   quit                 presses Escape (the app's quit key) with the pointer over the 3D view
@@ -34,6 +35,8 @@ click() { at "$1" "$2"; xdotool click 1; settle; }
 ctrl_click() { at "$1" "$2"; xdotool keydown ctrl; sleep 0.2; xdotool click 1; sleep 0.2; xdotool keyup ctrl; settle; }
 drag() { at "$1" "$2"; xdotool mousedown 1; sleep 0.3; xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5;
          xdotool mouseup 1; settle; }
+cut() { at "$1" "$2"; xdotool keydown shift; sleep 0.2; xdotool mousedown 3; sleep 0.3;
+        xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5; xdotool mouseup 3; sleep 0.2; xdotool keyup shift; settle; }
 quit() { at 900 400; key Escape; }
 shot() {
   rm -f clothsim-*.png

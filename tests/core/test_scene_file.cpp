@@ -84,7 +84,7 @@ TEST_CASE("scene: every bundled scene loads, builds and stays finite for 2 simul
     REQUIRE(names.size() == 12);
     for (const std::string& name : names) {
         INFO("scene " << name);
-        // The stiff scenes run the 2 s on a coarser grid (tests/support.hpp), and one step at their own size.
+        // The costly scenes run the 2 s on a coarser grid (tests/support.hpp), and one step at their own size.
         if (clothsim::test::costly_scene(name)) {
             const clothsim::Scene shipped = clothsim::load_scene(name);
             clothsim::MassSpring full = clothsim::build_simulation(shipped);

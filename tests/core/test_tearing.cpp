@@ -158,3 +158,51 @@ TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {
     }
     CHECK(said);
 }
+
+TEST_CASE("cutting: a stroke across a hanging sheet parts it there; the lower piece falls, the upper still hangs", "[tearing]") {
+    Scene s = load_scene("hanging");
+    s.settings.colliders.ground.enabled = false;
+    s.settings.springs.tether_strain = 0.0f;
+    MassSpring sim = build_simulation(s);
+    sim.run_steps(30);
+    const std::uint64_t stamp = sim.topology_stamp();
+    // The cut: every spring with one end above y = c and the other below it (c: halfway down the sheet).
+    const int rows = sim.topology().rows, cols = sim.topology().cols;
+    const float c = 0.5f * (sim.position(0).y + sim.position(static_cast<std::size_t>(rows - 1) * cols).y);
+    const glm::vec3 p0 = sim.momentum();
+    const std::size_t broken = sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a.y - c) * (b.y - c) < 0.0f; });
+    CHECK(broken > 0);
+    CHECK(sim.broken_springs() == broken);
+    CHECK(sim.topology_stamp() != stamp);
+    CHECK(glm::length(sim.momentum() - p0) < 1e-6f);  // a cut removes forces, not momentum
+    for (const Spring& sp : sim.topology().springs) {
+        CHECK((sim.position(sp.a).y - c) * (sim.position(sp.b).y - c) >= 0.0f);
+    }
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    const std::size_t top = 0, bottom = static_cast<std::size_t>(rows - 1) * cols;
+    CHECK(piece[top] != piece[bottom]);
+    // The lower piece's centre of mass falls freely from its velocity at the cut: y'' = g - c y' (c =
+    // springs.damping), y(t) = y0 + g t / c + (v0 - g / c)(1 - exp(-c t)) / c; the upper piece's stays
+    // where it hung.
+    const std::vector<glm::vec3> velocity = sim.velocities();
+    auto centre = [&](std::uint32_t label, glm::dvec3* v) {
+        glm::dvec3 sum(0.0), momentum(0.0);
+        double mass = 0.0;
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+            if (piece[i] != label) continue;
+            sum += double(sim.state().mass[i]) * sim.state().position.get(i);
+            momentum += double(sim.state().mass[i]) * glm::dvec3(velocity[i]);
+            mass += sim.state().mass[i];
+        }
+        if (v) *v = momentum / mass;
+        return sum / mass;
+    };
+    glm::dvec3 v0;
+    const glm::dvec3 lower0 = centre(piece[bottom], &v0), upper0 = centre(piece[top], nullptr);
+    sim.run_steps(30);  // 0.5 s
+    const double t = 0.5, c_ = s.settings.springs.damping, g = s.settings.forces.gravity.y;
+    const double expected = lower0.y + g * t / c_ + (v0.y - g / c_) * (1.0 - std::exp(-c_ * t)) / c_;
+    CHECK(centre(piece[bottom], nullptr).y == Approx(expected).margin(0.01));
+    CHECK(std::abs(centre(piece[top], nullptr).y - upper0.y) < 0.05);
+    CHECK(sim.all_finite());
+}

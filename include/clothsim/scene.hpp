@@ -87,7 +87,7 @@ std::optional<std::string> clamp_to_range(Scene& scene, const FieldInfo& field);
 // The whole scene as a TOML document that parse_scene() reads back to the same Scene.
 std::string to_toml(const Scene& scene);
 
-std::filesystem::path scene_directory();  // $CLOTHSIM_SCENES, else the source tree's assets/scenes
+std::filesystem::path scene_directory();  // $CLOTHSIM_SCENES, else share/clothsim/scenes (data_dirs.hpp)
 std::vector<std::string> bundled_scene_names();
 
 // Largest grid accepted (particles); larger grids are rejected with a message, not attempted.

@@ -36,17 +36,13 @@
 #include <iostream>
 #include <vector>
 
-#ifndef CLOTHSIM_DEFAULT_TEXTURE_DIR
-#define CLOTHSIM_DEFAULT_TEXTURE_DIR "assets/textures"
-#endif
-
 namespace clothsim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
 std::filesystem::path texture_directory() {
-    return data_directory("CLOTHSIM_TEXTURES", CLOTHSIM_DEFAULT_TEXTURE_DIR);
+    return data_directory("CLOTHSIM_TEXTURES", "textures");
 }
 
 // The 3D view: the window right of the panel, in window coordinates (x, y from the top-left, w, h).

@@ -4,6 +4,7 @@
 #include "exit_codes.hpp"
 #include "headless.hpp"
 
+#include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,7 @@ using namespace clothsim;
 struct CommandLine {
     bool headless = false;
     std::string scene_name = "hanging";
+    std::string scene_argument;  // the positional SCENE (what a file manager passes: clothsim FILE)
     std::vector<std::string> overrides;
     HeadlessOptions options;
     bool list_scenes = false, list_fields = false, print_scene = false;
@@ -30,7 +32,10 @@ struct CommandLine {
 // The flags (CLI11), bound to `cl`.
 void add_flags(CLI::App& app, CommandLine& cl) {
     auto* headless_flag = app.add_flag("--headless", cl.headless, "Simulate without a window and report on stdout");
-    app.add_option("--scene", cl.scene_name, "Bundled scene name or path to a .toml scene file")->capture_default_str();
+    auto* scene = app.add_option("--scene", cl.scene_name, "Bundled scene name or path to a .toml scene file")
+                      ->capture_default_str();
+    app.add_option("scene", cl.scene_argument, "The same as --scene: a bundled scene name or a .toml file")
+        ->excludes(scene);
     auto* duration = app.add_option("--duration", cl.options.duration, "Simulated seconds to run (default 1)")
                          ->check(CLI::PositiveNumber);
     auto* steps = app.add_option("--steps", cl.options.steps, "Steps of integration.dt to run")->check(CLI::NonNegativeNumber);
@@ -115,6 +120,7 @@ std::string make_app_options(CommandLine& cl) {
 
 // Loads the scene with its --set overrides, then prints it, runs it headless or opens the app.
 int run(CommandLine& cl) {
+    if (!cl.scene_argument.empty()) cl.scene_name = cl.scene_argument;
     Scene scene = load_scene(cl.scene_name);
     for (const std::string& assignment : cl.overrides) apply_override(scene, assignment);
     if (cl.print_scene) {
@@ -136,9 +142,11 @@ int main(int argc, char** argv) {
     app.get_formatter()->column_width(36);
     CommandLine cl;
     add_flags(app, cl);
+    app.set_version_flag("--version", std::string("clothsim ") + CLOTHSIM_VERSION + " (fast solver kernel: " +
+                                          MassSpring::fast_kernel_name() + ")");
     try {
         app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
+    } catch (const CLI::Success& e) {  // --help, --version
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "clothsim: error: " << e.what() << "\n(run clothsim --help for the flags)\n";

@@ -22,10 +22,6 @@
 #include <type_traits>
 #include <utility>
 
-#ifndef CLOTHSIM_DEFAULT_SCENE_DIR
-#define CLOTHSIM_DEFAULT_SCENE_DIR "assets/scenes"
-#endif
-
 namespace clothsim {
 namespace {
 
@@ -439,7 +435,7 @@ Scene load_scene_file(const std::filesystem::path& path) {
 }
 
 std::filesystem::path scene_directory() {
-    return data_directory("CLOTHSIM_SCENES", CLOTHSIM_DEFAULT_SCENE_DIR);
+    return data_directory("CLOTHSIM_SCENES", "scenes");
 }
 
 std::vector<std::string> bundled_scene_names() {

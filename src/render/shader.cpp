@@ -9,10 +9,6 @@
 #include <sstream>
 #include <vector>
 
-#ifndef CLOTHSIM_DEFAULT_SHADER_DIR
-#define CLOTHSIM_DEFAULT_SHADER_DIR "shaders"
-#endif
-
 namespace clothsim::gl {
 namespace {
 
@@ -88,7 +84,7 @@ std::string annotate_log(const std::string& log, const std::string& file) {
 }
 
 std::filesystem::path shader_directory() {
-    return data_directory("CLOTHSIM_SHADERS", CLOTHSIM_DEFAULT_SHADER_DIR);
+    return data_directory("CLOTHSIM_SHADERS", "shaders");
 }
 
 Shader::Shader(const std::filesystem::path& vertex, const std::filesystem::path& fragment) {

@@ -40,6 +40,6 @@ private:
 // both name the source string 0). Exposed for the tests.
 std::string annotate_log(const std::string& log, const std::string& file);
 
-std::filesystem::path shader_directory();  // $CLOTHSIM_SHADERS, else the source tree's shaders/
+std::filesystem::path shader_directory();  // $CLOTHSIM_SHADERS, else share/clothsim/shaders (data_dirs.hpp)
 
 }  // namespace clothsim::gl

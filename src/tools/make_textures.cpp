@@ -1,9 +1,12 @@
-// make_textures: writes the two procedural textures the renderer uses, as 256x256 RGB PNGs.
+// make_textures: writes the two procedural textures the renderer uses, as 256x256 RGB PNGs, and the
+// program's icon.
 //   fabric.png  a tileable red-orange 2/2 twill weave, with lighter thread stripes every 32 px so that the
 //               motion of the cloth stays visible.
 //   crate.png   light blue-grey metal panels with a darker 12 px border and a diagonal cross brace, for the
 //               cube collider.
-// Usage: make_textures OUTPUT_DIR. Output is deterministic (fixed-seed integer hashing, no clock or RNG), so
+//   clothsim.png the desktop icon (256x256 RGBA, installed under share/icons): an orange cloth with its grid
+//               of springs, hanging from two pins, on a rounded dark-blue tile.
+// Usage: make_textures OUTPUT_DIR [ICON_DIR]. Output is deterministic (fixed-seed integer hashing, no clock or RNG), so
 // regenerating never shows up as a change in git. Exit codes: 0 ok, 2 bad usage or a failed write.
 #include <stb_image_write.h>
 
@@ -205,12 +208,66 @@ bool write_png(const std::filesystem::path& path, const Image& img) {
     return true;
 }
 
+// The icon, straight RGBA (transparent outside the tile).
+std::vector<unsigned char> make_icon() {
+    std::vector<unsigned char> px(static_cast<std::size_t>(kSize) * kSize * 4, 0);
+    auto put = [&](int x, int y, const Rgb& c, double alpha) {
+        if (x < 0 || y < 0 || x >= kSize || y >= kSize) return;
+        const std::size_t i = (static_cast<std::size_t>(y) * kSize + static_cast<std::size_t>(x)) * 4;
+        for (std::size_t k = 0; k < 3; ++k) px[i + k] = static_cast<unsigned char>(std::clamp(std::lround(c[k]), 0L, 255L));
+        px[i + 3] = static_cast<unsigned char>(std::clamp(std::lround(alpha * 255.0), 0L, 255L));
+    };
+    // The tile: a rounded square with a vertical gradient; its edge antialiased over one pixel.
+    constexpr double kMargin = 8.0, kRadius = 40.0;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const double cx = std::clamp(x + 0.5, kMargin + kRadius, kSize - kMargin - kRadius);
+            const double cy = std::clamp(y + 0.5, kMargin + kRadius, kSize - kMargin - kRadius);
+            const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy) - kRadius;
+            const double alpha = std::clamp(0.5 - d, 0.0, 1.0);
+            if (alpha > 0.0) put(x, y, mix(Rgb{46, 64, 96}, Rgb{22, 30, 48}, y / double(kSize)), alpha);
+        }
+    }
+    // The cloth, splatted from a fine (u, v) grid: hung from its top corners, the top edge sags between the
+    // pins and the lower part falls in three soft folds; shading follows the folds' slope.
+    const double pi = std::numbers::pi;
+    auto point = [&](double u, double v, double& x, double& y) {
+        x = 52.0 + 152.0 * u + 10.0 * v * std::sin(3.0 * pi * u);
+        y = 52.0 + 22.0 * std::sin(pi * u) * (1.0 - 0.6 * v) + 150.0 * v;
+    };
+    constexpr int kFine = 900, kCells = 8;
+    for (int j = 0; j <= kFine; ++j) {
+        for (int i = 0; i <= kFine; ++i) {
+            const double u = i / double(kFine), v = j / double(kFine);
+            double x = 0.0, y = 0.0;
+            point(u, v, x, y);
+            const double slope = v * std::cos(3.0 * pi * u);  // the folds' tilt toward the light
+            Rgb c = scale(Rgb{226, 110, 52}, 0.78 + 0.22 * slope);
+            const double gu = std::abs(u * kCells - std::round(u * kCells)), gv = std::abs(v * kCells - std::round(v * kCells));
+            if (std::min(gu, gv) < 0.045) c = scale(c, 0.62);  // the springs between particles
+            put(static_cast<int>(x), static_cast<int>(y), c, 1.0);
+        }
+    }
+    // Two pins at the top corners: light discs with a dark rim.
+    for (const double u : {0.0, 1.0}) {
+        double px0 = 0.0, py0 = 0.0;
+        point(u, 0.0, px0, py0);
+        for (int y = int(py0) - 12; y <= int(py0) + 12; ++y) {
+            for (int x = int(px0) - 12; x <= int(px0) + 12; ++x) {
+                const double d = std::hypot(x + 0.5 - px0, y + 0.5 - py0);
+                if (d < 9.0) put(x, y, d < 6.5 ? Rgb{236, 238, 242} : Rgb{90, 96, 110}, 1.0);
+            }
+        }
+    }
+    return px;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        std::cerr << "usage: make_textures OUTPUT_DIR\n"
-                     "  writes OUTPUT_DIR/fabric.png and OUTPUT_DIR/crate.png\n";
+    if (argc != 2 && argc != 3) {
+        std::cerr << "usage: make_textures OUTPUT_DIR [ICON_DIR]\n"
+                     "  writes OUTPUT_DIR/fabric.png and OUTPUT_DIR/crate.png, and ICON_DIR/clothsim.png\n";
         return 2;
     }
     const std::filesystem::path dir = argv[1];
@@ -223,6 +280,17 @@ int main(int argc, char** argv) {
     }
     if (!write_png(dir / "fabric.png", make_fabric()) || !write_png(dir / "crate.png", make_crate())) {
         return 2;
+    }
+    if (argc == 3) {
+        const std::filesystem::path icon_dir = argv[2];
+        std::filesystem::create_directories(icon_dir, ec);
+        const std::string icon = (icon_dir / "clothsim.png").string();
+        const std::vector<unsigned char> pixels = make_icon();
+        if (ec || stbi_write_png(icon.c_str(), kSize, kSize, 4, pixels.data(), kSize * 4) == 0) {
+            std::cerr << "make_textures: failed to write " << icon << '\n';
+            return 2;
+        }
+        std::cout << "wrote " << icon << " (" << kSize << "x" << kSize << " RGBA)\n";
     }
     return 0;
 }

@@ -89,6 +89,9 @@ std::string to_toml(const Scene& scene);
 
 std::filesystem::path scene_directory();  // $CLOTHSIM_SCENES, else share/clothsim/scenes (data_dirs.hpp)
 std::vector<std::string> bundled_scene_names();
+// Whether load_scene() reads `name_or_path` as a file (it has a '/' or ends in .toml) rather than as the name
+// of a bundled scene.
+bool is_scene_file(std::string_view name_or_path);
 
 // Largest grid accepted (particles); larger grids are rejected with a message, not attempted.
 inline constexpr long long kMaxParticles = 1024LL * 1024LL;

@@ -34,6 +34,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <utility>
 #include <vector>
 
 namespace clothsim {
@@ -136,22 +137,23 @@ void record_plots(AppState& app, bool rested) {
     }
 }
 
-// This frame's physics, through the stepper: one step per frame in scripted runs, one for Step, otherwise
+// This frame's physics, through the stepper: one step per frame in scripted runs and while recording, one
+// for Step, otherwise
 // the wall time that passed (scaled) in fixed steps of integration.dt. Returns true when the scene must
 // restart (the guard failed twice in a row).
-bool simulate(AppState& app, double wall_seconds, bool scripted) {
+bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
     const auto start = Clock::now();
     app.sim.reset_profile();
     const bool was_resting = app.sim.resting();
     StepReport report;
-    if (scripted) {
-        report = app.stepper.run(app.sim, app.paused ? 0 : 1);
-    } else if (app.step_once) {
+    if (app.step_once) {
         report = app.stepper.run(app.sim, 1);
-    } else if (!app.paused) {
-        report = app.stepper.advance(app.sim, wall_seconds * app.time_scale);
-    } else {
+    } else if (app.paused) {
         report = app.stepper.run(app.sim, 0);  // auto substeps still follows the panel's edits
+    } else if (one_step_a_frame) {
+        report = app.stepper.run(app.sim, 1);
+    } else {
+        report = app.stepper.advance(app.sim, wall_seconds * app.time_scale);
     }
     app.step_once = false;
     const bool restart = report_guard(app, report);
@@ -271,26 +273,42 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     if (ground.enabled) app.camera.keep_above(ground.height);
 }
 
-// Key presses collected by a GLFW callback. ImGui 1.86 (before its 1.87 input queue) sees only the key
-// state at each frame, so a tap shorter than a frame would be lost; the queue keeps every press.
-struct KeyQueue {
+// Key presses and dropped files collected by GLFW callbacks. ImGui 1.86 (before its 1.87 input queue) sees
+// only the key state at each frame, so a tap shorter than a frame would be lost; the queue keeps every press.
+struct InputQueue {
     std::vector<int> pressed;
+    std::vector<std::string> dropped;  // paths dropped onto the window since the last frame
 };
 
 void on_key(GLFWwindow* window, int key, int, int action, int) {
     if (action != GLFW_PRESS) return;
-    if (auto* queue = static_cast<KeyQueue*>(glfwGetWindowUserPointer(window))) queue->pressed.push_back(key);
+    if (auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window))) queue->pressed.push_back(key);
 }
 
-void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
-    const std::vector<int> pressed_keys = std::move(keys.pressed);
-    keys.pressed.clear();
+void on_drop(GLFWwindow* window, int count, const char** paths) {
+    auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
+    for (int i = 0; queue && i < count; ++i) queue->dropped.emplace_back(paths[i]);
+}
+
+// Files dropped onto the window: the first .toml opens as "Open file" would; the others are refused, said why.
+void handle_drop(AppState& app, InputQueue& input, PanelRequests& requests) {
+    if (input.dropped.empty()) return;
+    const DropChoice choice = choose_dropped_scene(input.dropped);
+    input.dropped.clear();
+    for (const std::string& why : choice.refused) app.say(why, true);
+    if (choice.open) requests.load = choice.open;
+}
+
+void handle_keys(AppState& app, InputQueue& input, PanelRequests& requests) {
+    const std::vector<int> pressed_keys = std::move(input.pressed);
+    input.pressed.clear();
     auto pressed = [&](int key) {
         return std::find(pressed_keys.begin(), pressed_keys.end(), key) != pressed_keys.end();
     };
     // F12 types nothing: it takes a screenshot even while a text field has the keyboard.
     if (pressed(GLFW_KEY_F12)) requests.screenshot = true;
-    if (ImGui::GetIO().WantCaptureKeyboard) return;
+    if (pressed(GLFW_KEY_F9)) requests.record = true;
+    if (ImGui::GetIO().WantCaptureKeyboard || app.dialogs.browser.is_open()) return;
     if (pressed(GLFW_KEY_SPACE)) app.paused = !app.paused;
     if (pressed(GLFW_KEY_S)) {
         app.paused = true;
@@ -304,36 +322,101 @@ void handle_keys(AppState& app, KeyQueue& keys, PanelRequests& requests) {
     if (pressed(GLFW_KEY_ESCAPE)) requests.quit = true;
 }
 
-// Atomic (atomic_file.hpp): a failed save leaves the old file as it was and says why.
+// Where the file dialogs start: the folder of the scene's file, else of the most recent file, else the
+// working folder.
+std::filesystem::path dialog_folder(const AppState& app) {
+    std::error_code ec;
+    if (is_scene_file(app.scene_source)) return std::filesystem::absolute(app.scene_source, ec).parent_path();
+    if (!app.recent.files().empty()) return std::filesystem::path(app.recent.files().front()).parent_path();
+    return std::filesystem::current_path(ec);
+}
+
+// "Open file..." and "Save scene as...": the desktop's dialog (zenity, kdialog) when there is one, else the
+// ImGui browser. Saving proposes the scene's own file, or NAME-edited.toml in the working folder.
+void start_file_dialog(AppState& app, FileDialogMode mode) {
+    if (app.dialogs.open()) return;
+    const bool from_file = is_scene_file(app.scene_source);
+    std::error_code ec;
+    const std::filesystem::path folder =
+        mode == FileDialogMode::Save && !from_file ? std::filesystem::current_path(ec) : dialog_folder(app);
+    const std::string name = mode == FileDialogMode::Open ? ""
+                             : from_file                  ? std::filesystem::path(app.scene_source).filename().string()
+                                                          : app.scene.name + "-edited.toml";
+    if (const auto tool = desktop_dialog_tool()) {
+        const std::string error = app.dialogs.desktop.start(dialog_command(*tool, mode, folder, name));
+        if (error.empty()) {
+            app.dialogs.desktop_mode = mode;
+            return;
+        }
+        app.say(error + "; using the built-in file browser", true);
+    }
+    app.dialogs.browser.open(mode, folder, name);
+}
+
+// A chosen file becomes a load or a save request.
+void ask_for(PanelRequests& requests, FileDialogMode mode, const std::string& path) {
+    if (mode == FileDialogMode::Open) requests.load = path;
+    else requests.save = path;
+}
+
+// The desktop dialog, polled once a frame: its choice, or why it failed (then the built-in browser opens).
+void poll_file_dialog(AppState& app, PanelRequests& requests) {
+    if (!app.dialogs.desktop.running()) return;
+    const auto result = app.dialogs.desktop.poll();
+    if (!result) return;
+    if (result->path) ask_for(requests, app.dialogs.desktop_mode, *result->path);
+    if (!result->error.empty()) {
+        app.say(result->error + "; using the built-in file browser", true);
+        start_file_dialog(app, app.dialogs.desktop_mode);
+    }
+}
+
+// The loaded scene becomes what the title compares against, and a file joins the recent files.
+void loaded_from(AppState& app, const std::string& source) {
+    app.scene_source = source;
+    app.loaded_toml = to_toml(app.loaded);
+    if (is_scene_file(source)) {
+        if (const std::string error = app.recent.add(source); !error.empty()) app.say("recent files not saved: " + error, true);
+    }
+}
+
+// Atomic (atomic_file.hpp): a failed save leaves the old file as it was and says why. A saved scene is the
+// document's file from then on, as in any editor: the title loses its mark, and R returns to what was saved.
 bool save_scene(AppState& app, const std::string& path) {
     std::string error;
-    if (!write_file_atomically(path, to_toml(app.document()), error)) {
+    const Scene document = app.document();
+    if (!write_file_atomically(path, to_toml(document), error)) {
         app.say("not saved: " + error, true);
         return false;
     }
+    app.loaded = document;
+    loaded_from(app, path);
     app.say("saved " + path);
     return true;
 }
 
-// Every label that names the scene follows the one loaded: the window title, the file fields' paths.
-void follow_scene(AppState& app, const Window& window) {
-    glfwSetWindowTitle(window.get(), ("clothsim - " + app.scene.name).c_str());
-    app.save_path = app.scene.name + "-edited.toml";
-    app.open_path = std::filesystem::absolute(app.scene_source.ends_with(".toml")
-                                                  ? std::filesystem::path(app.scene_source)
-                                                  : scene_directory() / (app.scene_source + ".toml"))
-                        .string();
+// The window title names the scene, with a '*' when the settings differ from the file it came from (or
+// from the bundled scene). Auto substeps and the guard choose integration.substeps themselves: that is no
+// edit of the user's.
+void update_title(AppState& app, const Window& window, std::string& shown) {
+    Scene document = app.document();
+    document.settings.integration.substeps = app.loaded.settings.integration.substeps;
+    const std::string title = "clothsim - " + app.scene.name + (to_toml(document) != app.loaded_toml ? "*" : "");
+    if (title == shown) return;
+    glfwSetWindowTitle(window.get(), title.c_str());
+    shown = title;
 }
 
 void apply_requests(AppState& app, Renderer& renderer, const Window& window, float scale, PanelRequests& requests) {
     const float aspect = view_aspect(app, window, scale);
+    if (requests.open_dialog) start_file_dialog(app, FileDialogMode::Open);
+    if (requests.save_dialog) start_file_dialog(app, FileDialogMode::Save);
     if (requests.load) {
         // Loaded and built in one step: a rejected file keeps the user's edits and the running cloth.
         if (auto error = open_scene(*requests.load, app.scene, app.loaded, app.sim)) {
             app.say(*error, true);
         } else {
-            app.scene_source = *requests.load;
-            follow_scene(app, window);
+            loaded_from(app, *requests.load);
             after_rebuild(app, renderer);
             reset_camera(app, aspect);
             app.say("loaded " + *requests.load);
@@ -391,7 +474,7 @@ std::string write_screenshot(const std::string& path, int width, int height) {
 namespace {
 
 // Dear ImGui over GLFW and OpenGL 3.3, scaled for the monitor; no ini file (the layout is fixed).
-void start_imgui(const Window& window, KeyQueue& keys, float scale) {
+void start_imgui(const Window& window, InputQueue& input, float scale) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
@@ -402,8 +485,9 @@ void start_imgui(const Window& window, KeyQueue& keys, float scale) {
     ImGui::StyleColorsDark();
     ImGui::GetStyle().ScaleAllSizes(scale);
     // Installed before ImGui's, which chains to it.
-    glfwSetWindowUserPointer(window.get(), &keys);
+    glfwSetWindowUserPointer(window.get(), &input);
     glfwSetKeyCallback(window.get(), on_key);
+    glfwSetDropCallback(window.get(), on_drop);
     ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 }
@@ -441,6 +525,7 @@ PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window
     app.stats.times.add_frame(app.stats.profile, cloth.normals_ms, cloth.upload_ms);
     PanelRequests requests;
     if (app.show_panel) requests = draw_panel(app, scale);
+    if (auto chosen = app.dialogs.browser.draw(scale)) ask_for(requests, app.dialogs.browser.mode(), *chosen);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     app.stats.render_ms = std::chrono::duration<float, std::milli>(Clock::now() - render_start).count();
@@ -454,13 +539,78 @@ void merge_requests(PanelRequests& into, const PanelRequests& panel) {
     into.frame_camera |= panel.frame_camera;
     into.reset_camera |= panel.reset_camera;
     into.screenshot |= panel.screenshot;
+    into.record ^= panel.record;  // F9 and the button in one frame cancel out
+    into.open_dialog |= panel.open_dialog;
+    into.save_dialog |= panel.save_dialog;
     into.quit |= panel.quit;
     if (panel.load) into.load = panel.load;
     if (panel.save) into.save = panel.save;
 }
 
+// A new folder for F9's recording in the working folder: clothsim-recording-YYYYMMDD-HHMMSS (-2, -3, ...
+// when taken), or the error.
+std::filesystem::path new_recording_folder(std::string& error) {
+    const std::time_t now = std::time(nullptr);
+    char stamp[64];
+    std::strftime(stamp, sizeof stamp, "clothsim-recording-%Y%m%d-%H%M%S", std::localtime(&now));
+    std::string name = stamp;
+    std::error_code ec;
+    for (int n = 2; std::filesystem::exists(name, ec); ++n) name = std::string(stamp) + "-" + std::to_string(n);
+    if (!std::filesystem::create_directory(name, ec)) error = "cannot create the folder " + name + ": " + ec.message();
+    return std::filesystem::absolute(name, ec);
+}
+
+// The one-line ffmpeg command that makes a video of a recording, at its frame rate (1 / dt: one step a frame).
+std::string video_command(const AppState& app, const std::filesystem::path& folder) {
+    char rate[32];
+    std::snprintf(rate, sizeof rate, "%g", 1.0 / app.sim.settings().integration.dt);
+    return std::string("ffmpeg -framerate ") + rate + " -i " + (folder / "frame-%06d.png").string() +
+           " -pix_fmt yuv420p " + folder.string() + ".mp4";
+}
+
+// F9 and the Record button: start recording into a new folder, or stop and say how to make the video.
+void toggle_recording(AppState& app) {
+    if (app.recording) {
+        app.say("recorded " + std::to_string(app.recording->frames) + " frames to " + app.recording->folder.string() +
+                "; make a video: " + video_command(app, app.recording->folder));
+        app.recording.reset();
+        return;
+    }
+    std::string error;
+    const std::filesystem::path folder = new_recording_folder(error);
+    if (!error.empty()) {
+        app.say("not recording: " + error, true);
+        return;
+    }
+    app.recording = Recording{folder, 0};
+    app.say("recording every frame to " + folder.string() + " (one step of integration.dt per frame); F9 stops");
+}
+
+// While recording, this frame (the back buffer, panel included) as the next numbered PNG. A frame that cannot
+// be written stops the recording and says why.
+bool record_frame(AppState& app, glm::ivec2 fb) {
+    if (!app.recording) return true;
+    const std::filesystem::path file = app.recording->folder / recording_frame_name(app.recording->frames + 1);
+    const int level = std::exchange(stbi_write_png_compression_level, 5);
+    const int filter = std::exchange(stbi_write_force_png_filter, 1);
+    const std::string error = write_screenshot(file.string(), fb.x, fb.y);
+    stbi_write_png_compression_level = level;
+    stbi_write_force_png_filter = filter;
+    if (!error.empty()) {
+        app.say(error + "; recording stopped after " + std::to_string(app.recording->frames) + " frames", true);
+        app.recording.reset();
+        return false;
+    }
+    ++app.recording->frames;
+    return true;
+}
+
 // A scripted run's last frame: the screenshot it asked for. Returns the exit code.
-int finish_scripted(const AppOptions& options, glm::ivec2 fb, long long frame) {
+int finish_scripted(const AppState& app, const AppOptions& options, glm::ivec2 fb, long long frame) {
+    if (app.recording) {
+        std::cout << "wrote " << app.recording->frames << " frames to " << app.recording->folder.string() << " ("
+                  << fb.x << "x" << fb.y << "); make a video: " << video_command(app, app.recording->folder) << "\n";
+    }
     if (options.screenshot.empty()) return kExitOk;
     const std::string error = write_screenshot(options.screenshot, fb.x, fb.y);
     if (!error.empty()) {
@@ -482,8 +632,9 @@ void take_screenshot(AppState& app, glm::ivec2 fb) {
 // what the frame asked for. Returns the exit code.
 int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOptions& options, float scale) {
     const bool scripted = options.frames.has_value();
-    KeyQueue keys;
-    start_imgui(window, keys, scale);
+    InputQueue input;
+    start_imgui(window, input, scale);
+    std::string title;
     int exit_code = kExitOk;
     long long frame = 0;
     bool vsync_applied = !scripted;
@@ -496,10 +647,12 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         ImGui::NewFrame();
 
         PanelRequests requests;
-        handle_keys(app, keys, requests);
+        handle_keys(app, input, requests);
+        handle_drop(app, input, requests);
+        poll_file_dialog(app, requests);
         handle_mouse(app, window, scale);
         const auto now = Clock::now();
-        requests.reset |= simulate(app, std::chrono::duration<double>(now - last).count(), scripted);
+        requests.reset |= simulate(app, std::chrono::duration<double>(now - last).count(), scripted || app.recording);
         last = now;
         merge_requests(requests, draw_frame(app, renderer, window, scale));
         ++frame;
@@ -516,11 +669,16 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
             app.say(text, true);
         }
         const glm::ivec2 fb = window.framebuffer_size();
+        if (!record_frame(app, fb) && scripted) {
+            exit_code = kExitBadInput;
+            break;
+        }
         if (scripted && frame >= *options.frames) {
-            exit_code = finish_scripted(options, fb, frame);
+            exit_code = finish_scripted(app, options, fb, frame);
             break;
         }
         if (requests.screenshot) take_screenshot(app, fb);
+        if (requests.record) toggle_recording(app);
         if (!scripted && app.vsync != vsync_applied) {
             window.set_vsync(app.vsync);
             vsync_applied = app.vsync;
@@ -531,12 +689,33 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         }
         if (requests.quit) glfwSetWindowShouldClose(window.get(), GLFW_TRUE);
         apply_requests(app, renderer, window, scale, requests);
+        update_title(app, window, title);
     }
+    if (app.recording && !scripted) toggle_recording(app);  // closing the window ends a recording: say where it is
     stop_imgui();
     return exit_code;
 }
 
 }  // namespace
+
+std::string recording_frame_name(long long n) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%06lld.png", n);
+    return name;
+}
+
+std::string prepare_record_folder(const std::filesystem::path& folder) {
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec || !std::filesystem::is_directory(folder, ec)) {
+        return "cannot create the folder" + (ec ? ": " + ec.message() : std::string(": a file has that name"));
+    }
+    if (std::filesystem::exists(folder / recording_frame_name(1), ec)) {
+        return "the folder already holds a recording (" + recording_frame_name(1) +
+               "); its frames would mix with the new ones: choose a new or empty folder";
+    }
+    return "";
+}
 
 int run_app(const Scene& scene, const AppOptions& options) {
     const bool scripted = options.frames.has_value();
@@ -551,6 +730,12 @@ int run_app(const Scene& scene, const AppOptions& options) {
         const auto parent = std::filesystem::path(options.screenshot).parent_path();
         if (!parent.empty() && !std::filesystem::is_directory(parent)) {
             std::cerr << "clothsim: error: --screenshot " << options.screenshot << ": the directory does not exist\n";
+            return kExitBadInput;
+        }
+    }
+    if (!options.record.empty()) {
+        if (const std::string error = prepare_record_folder(options.record); !error.empty()) {
+            std::cerr << "clothsim: error: --record " << options.record << ": " << error << "\n";
             return kExitBadInput;
         }
     }
@@ -569,7 +754,9 @@ int run_app(const Scene& scene, const AppOptions& options) {
     policy.guard = true;
     AppState app(scene, options.scene_source, policy);
     start_panel(app, options);
-    follow_scene(app, *window);
+    if (!scripted) app.recent = RecentFiles::from_config();  // scripted runs leave the user's list alone
+    loaded_from(app, options.scene_source);
+    if (!options.record.empty()) app.recording = Recording{std::filesystem::absolute(options.record), 0};
     renderer->set_cloth(app.sim);
     const float scale = window->content_scale();
     reset_camera(app, view_aspect(app, *window, scale));

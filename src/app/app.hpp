@@ -7,6 +7,7 @@
 
 #include <glm/vec2.hpp>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -19,6 +20,8 @@ struct AppOptions {
     // clock says), write the last one to `screenshot` (panel included) and exit.
     std::optional<long long> frames;
     std::string screenshot;
+    // With `frames`: every frame written as record/frame-000001.png, ... (--record).
+    std::string record;
     // Interactive runs: start paused (--paused; nothing is stepped until Play, Space or S), and end after
     // this many wall seconds as if the window were closed (--quit-after; exit code 0).
     bool start_paused = false;
@@ -39,6 +42,10 @@ int run_app(const Scene& scene, const AppOptions& options);
 
 // Writes the current back buffer (RGBA, bottom-up) as PNG; returns an error message or "".
 std::string write_screenshot(const std::string& path, int width, int height);
+
+// --record's folder: created when missing; refused (the message) when it already holds a recording's
+// frames, which would mix with the new ones. "" when ready.
+std::string prepare_record_folder(const std::filesystem::path& folder);
 
 // "clothsim-20261124-101530.png": screenshots taken with F12.
 std::string timestamped_screenshot_name();

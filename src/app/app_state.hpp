@@ -3,6 +3,9 @@
 #pragma once
 
 #include "camera.hpp"
+#include "file_browser.hpp"
+#include "file_dialog.hpp"
+#include "recent_files.hpp"
 #include "renderer.hpp"
 #include "scene_loading.hpp"
 
@@ -14,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <filesystem>
 #include <iostream>
 #include <cstddef>
 #include <optional>
@@ -105,6 +109,24 @@ struct Grab {
     glm::vec3 plane_normal{0.0f, 0.0f, 1.0f};
 };
 
+// A recording in progress: every drawn frame written as DIR/frame-NNNNNN.png (one step of integration.dt
+// per frame, so the frames play back at 1 / dt frames per second in real time).
+struct Recording {
+    std::filesystem::path folder;
+    long long frames = 0;
+};
+
+// "frame-000001.png", the name of a recording's frame `n` (from 1), as ffmpeg's frame-%06d.png reads them.
+std::string recording_frame_name(long long n);
+
+// The file dialogs: the desktop's own (zenity, kdialog) when installed, else the ImGui browser.
+struct FileDialogs {
+    DesktopDialog desktop;
+    FileDialogMode desktop_mode = FileDialogMode::Open;
+    FileBrowser browser;
+    bool open() const { return desktop.running() || browser.is_open(); }
+};
+
 struct AppState {
     // The document: name, cloth and pins as edited, what Reset returns to (`loaded`). The live settings are
     // the simulation's alone; document() joins the two into what "Save scene as" writes.
@@ -125,8 +147,10 @@ struct AppState {
     Stats stats;
     std::optional<Grab> grab;
     Messages messages;         // what the app tells the user (errors, notes, screenshot paths)
-    std::string open_path;     // the panel's "Open scene file" text
-    std::string save_path;     // the panel's "Save scene as" text
+    FileDialogs dialogs;       // "Open file..." and "Save scene as..."
+    RecentFiles recent{std::filesystem::path()};  // the Recent menu (read from the config folder by the app)
+    std::optional<Recording> recording;  // Record (F9)
+    std::string loaded_toml;   // `loaded` as TOML: the window title marks a document that differs from it
 
     AppState(const Scene& s, std::string source, const RunPolicy& policy)
         : scene(s), loaded(s), scene_source(std::move(source)), sim(build_simulation(s)), stepper(policy), start_policy(policy) {}
@@ -149,6 +173,9 @@ struct PanelRequests {
     bool frame_camera = false;
     bool reset_camera = false;
     bool screenshot = false;
+    bool record = false;        // start or stop recording
+    bool open_dialog = false;   // "Open file..."
+    bool save_dialog = false;   // "Save scene as..."
     bool quit = false;
     std::optional<std::string> load;  // a bundled scene name or a path
     std::optional<std::string> save;  // a path

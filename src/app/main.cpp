@@ -62,6 +62,9 @@ void add_flags(CLI::App& app, CommandLine& cl) {
                        ->check(CLI::PositiveNumber);
     app.add_option("--screenshot", cl.app_options.screenshot, "App: with --frames, write the last frame as PNG")
         ->needs(frames);
+    app.add_option("--record", cl.app_options.record,
+                   "App: with --frames, write every frame as DIR/frame-000001.png, ... (created if missing)")
+        ->needs(frames);
     app.add_flag("--paused", cl.app_options.start_paused, "App: start paused (Space or Play runs, S steps once)")
         ->excludes(headless_flag);
     app.add_option("--quit-after", cl.app_options.quit_after, "App: close the window after this many wall seconds")

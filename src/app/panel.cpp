@@ -367,11 +367,13 @@ void help_section() {
     ImGui::BulletText("wheel: zoom");
     ImGui::BulletText("left-drag on the cloth: grab a particle");
     ImGui::BulletText("ctrl+click on the cloth: pin / unpin a particle");
+    ImGui::BulletText("drop a .toml file onto the window: open it");
     ImGui::TextUnformatted("Keys");
     ImGui::BulletText("Space: pause / play      S: single step");
     ImGui::BulletText("R: reset the scene       W: wireframe");
     ImGui::BulletText("H: hide / show panel     F: frame the cloth");
     ImGui::BulletText("Home: reset the camera   F12: screenshot");
+    ImGui::BulletText("F9: start / stop recording frames");
     ImGui::BulletText("Esc: quit");
 }
 
@@ -401,35 +403,39 @@ void message_area(AppState& app, float height) {
     if (ImGui::SmallButton("Clear messages")) app.messages.clear();
 }
 
-// A file path to type and the button that acts on it; returns true when the button was pressed.
-bool path_field(const char* id, std::string& path, const char* button, const char* tooltip) {
-    char text[512];
-    std::snprintf(text, sizeof text, "%s", path.c_str());
-    if (ImGui::InputText(id, text, sizeof text)) path = text;
-    ImGui::SameLine();
-    const bool pressed = ImGui::Button(button);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tooltip);
-    return pressed;
-}
-
-// Bundled scenes, open a file, play / step / reset, time scale, save.
+// Bundled scenes, open a file, recent files, play / step / reset, time scale, save, record.
 void scene_section(AppState& app, PanelRequests& requests) {
     const std::vector<std::string> names = bundled_scene_names();
-    // The combo names the scene that runs: a bundled one by name, a file by its file name (full path in the
-    // tooltip and in the file field below).
-    const bool from_file = app.scene_source.ends_with(".toml");
-    const std::string shown = from_file ? std::filesystem::path(app.scene_source).filename().string() : app.scene_source;
-    if (ImGui::BeginCombo("bundled", shown.c_str())) {
+    // The combo shows the scene's name, and for a scene from a file its file name (the full path in the
+    // tooltip); its items are the bundled scenes.
+    const bool from_file = is_scene_file(app.scene_source);
+    const std::string shown =
+        from_file ? app.scene.name + " (" + std::filesystem::path(app.scene_source).filename().string() + ")" : app.scene.name;
+    if (ImGui::BeginCombo("scene", shown.c_str())) {
         for (const std::string& n : names) {
-            if (ImGui::Selectable(n.c_str(), n == app.scene_source)) requests.load = n;
+            if (ImGui::Selectable(n.c_str(), !from_file && n == app.scene_source)) requests.load = n;
         }
         ImGui::EndCombo();
     }
-    if (from_file && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", app.scene_source.c_str());
-    if (path_field("##open", app.open_path, "Open file",
-                   "load a .toml scene file; a bad file is rejected and nothing changes")) {
-        requests.load = app.open_path;
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("%s", from_file ? app.scene_source.c_str() : "a bundled scene; pick another here");
     }
+    const bool dialog_open = app.dialogs.open();
+    ImGui::BeginDisabled(dialog_open);
+    if (ImGui::Button("Open file...")) requests.open_dialog = true;
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+        ImGui::SetTooltip("opens a .toml scene file (or drop one onto the window); a bad file is rejected and nothing changes");
+    }
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
+    if (ImGui::BeginCombo("##recent", "Recent", ImGuiComboFlags_HeightLarge)) {
+        if (app.recent.files().empty()) ImGui::TextDisabled("no recent files");
+        for (const std::string& f : app.recent.files()) {
+            if (ImGui::Selectable(f.c_str())) requests.load = f;
+        }
+        ImGui::EndCombo();
+    }
+    ImGui::EndDisabled();
     if (ImGui::Button(app.paused ? "Play (Space)" : "Pause (Space)")) app.paused = !app.paused;
     ImGui::SameLine();
     if (ImGui::Button("Step (S)")) {
@@ -441,8 +447,23 @@ void scene_section(AppState& app, PanelRequests& requests) {
     ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx",
                        ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
-    if (path_field("##save", app.save_path, "Save scene as", "writes the current settings as a scene file (atomically)")) {
-        requests.save = app.save_path;
+    ImGui::BeginDisabled(dialog_open);
+    if (ImGui::Button("Save scene as...")) requests.save_dialog = true;
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("writes the current settings as a scene file (atomically)");
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    if (app.recording) {
+        ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.15f, 0.15f, 1.0f));
+        const std::string label = "Stop recording (F9): " + std::to_string(app.recording->frames) + " frames";
+        if (ImGui::Button(label.c_str())) requests.record = true;
+        ImGui::PopStyleColor();
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("recording every frame to %s", app.recording->folder.c_str());
+    } else {
+        if (ImGui::Button("Record (F9)")) requests.record = true;
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("writes every frame as a PNG into a new folder clothsim-recording-DATE-TIME, one step of "
+                              "integration.dt per frame");
+        }
     }
 }
 

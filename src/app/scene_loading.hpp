@@ -8,12 +8,21 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace clothsim {
 
 // On success replaces all three and returns nothing; on failure returns the message (file, line, field)
 // and leaves them untouched.
 std::optional<std::string> open_scene(const std::string& source, Scene& edited, Scene& loaded, MassSpring& sim);
+
+// What a drop of files onto the window does: the first regular file ending in .toml is opened (through
+// open_scene, like "Open file"); every other file is refused with the reason, and nothing else changes.
+struct DropChoice {
+    std::optional<std::string> open;  // the file to open
+    std::vector<std::string> refused; // one message per file not opened
+};
+DropChoice choose_dropped_scene(const std::vector<std::string>& paths);
 
 // The scene as it runs, what "Save scene as" writes: the document (name, cloth and pins as edited) with
 // the simulation's live settings, which only the simulation holds.

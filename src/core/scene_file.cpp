@@ -448,10 +448,12 @@ std::vector<std::string> bundled_scene_names() {
     return names;
 }
 
+bool is_scene_file(std::string_view name_or_path) {
+    return name_or_path.find('/') != std::string_view::npos || std::filesystem::path(name_or_path).extension() == ".toml";
+}
+
 Scene load_scene(std::string_view name_or_path) {
-    const std::filesystem::path as_path(name_or_path);
-    const bool looks_like_path = name_or_path.find('/') != std::string_view::npos || as_path.extension() == ".toml";
-    if (looks_like_path) return load_scene_file(as_path);
+    if (is_scene_file(name_or_path)) return load_scene_file(std::filesystem::path(name_or_path));
     const std::filesystem::path bundled = scene_directory() / (std::string(name_or_path) + ".toml");
     if (std::filesystem::exists(bundled)) return load_scene_file(bundled);
     std::string names;

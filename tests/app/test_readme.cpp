@@ -36,7 +36,7 @@ TEST_CASE("readme lists every bundled scene and flag", "[readme]") {
     }
     for (const char* flag : {"--headless", "--scene", "--duration", "--steps", "--set", "--trajectory", "--every",
                              "--obj", "--json", "--list-scenes", "--list-fields", "--print-scene", "--frames", "--screenshot",
-                             "--size", "--view", "--auto-substeps", "--guard", "--version"}) {
+                             "--size", "--view", "--auto-substeps", "--guard", "--version", "--record"}) {
         INFO(flag);
         CHECK(text.find(std::string("`") + flag) != std::string::npos);
     }

@@ -600,3 +600,34 @@ TEST_CASE("render the cylinder where it is, and no cylinder when it is disabled"
     CHECK(around_box < 0.01 * static_cast<double>(around.area()));
     CHECK(in_box_without < 0.01 * static_cast<double>(box_without.area()));
 }
+
+TEST_CASE("render --record: N frames, each a PNG of the window's size, numbered from 1, the last one the screenshot") {
+    const TempDir dir("record");
+    const fs::path folder = dir / "frames";
+    const RunResult r = run_clothsim(dir, {"--scene", "flag", "--frames", "6", "--size", "640x360", "--record",
+                                           folder.string(), "--screenshot", (dir / "last.png").string()});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("wrote 6 frames to " + folder.string()) && Contains("ffmpeg -framerate 60 -i"));
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    REQUIRE(names == std::vector<std::string>{"frame-000001.png", "frame-000002.png", "frame-000003.png",
+                                              "frame-000004.png", "frame-000005.png", "frame-000006.png"});
+    std::vector<Image> frames;
+    for (const std::string& n : names) {
+        frames.push_back(load_png(folder / n));
+        INFO(n);
+        REQUIRE(frames.back().width == 640);
+        REQUIRE(frames.back().height == 360);
+    }
+    const Rect whole{0, 0, 640, 360};
+    CHECK(differing_pixels(frames.front(), frames.back(), whole, 30) > 100);  // the flag moved: each frame is its own
+    CHECK(differing_pixels(frames.back(), load_png(dir / "last.png"), whole, 0) == 0);
+
+    // Recording again into the same folder would mix two runs' frames: refused, nothing written.
+    const RunResult again = run_clothsim(dir, {"--scene", "flag", "--frames", "8", "--size", "640x360", "--record", folder.string()});
+    CHECK(again.code == 2);
+    CHECK_THAT(again.err, Contains("--record") && Contains("already holds a recording"));
+    CHECK(!fs::exists(folder / "frame-000007.png"));
+}

@@ -1,6 +1,7 @@
 // open_scene: what the panel's Open does. A rejected file changes nothing the user has.
 #include "scene_loading.hpp"
 
+#include "app/run_process.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
@@ -120,4 +121,45 @@ TEST_CASE("running_scene: a panel change reaches the next substep and is what Sa
     CHECK(saved.settings == sim.settings());
     CHECK(saved.settings.springs.structural.x == 250.0f);
     CHECK(saved.cloth.rows == document.cloth.rows);
+}
+
+TEST_CASE("a drop opens the first .toml file and refuses every other file, saying why") {
+    const clothsim::test::TempDir dir("drop_choice");
+    const std::filesystem::path a = dir / "a.toml", b = dir / "b.toml", picture = dir / "cloth.png";
+    std::ofstream(a) << "name = \"a\"\n";
+    std::ofstream(b) << "name = \"b\"\n";
+    std::ofstream(picture) << "not a scene";
+    std::filesystem::create_directories(dir / "folder.toml");
+
+    const DropChoice one = choose_dropped_scene({a.string()});
+    CHECK(one.open == std::optional<std::string>(a.string()));
+    CHECK(one.refused.empty());
+
+    const DropChoice mixed = choose_dropped_scene(
+        {picture.string(), (dir / "folder.toml").string(), (dir / "missing.toml").string(), b.string(), a.string()});
+    CHECK(mixed.open == std::optional<std::string>(b.string()));
+    REQUIRE(mixed.refused.size() == 4);
+    CHECK_THAT(mixed.refused[0], Contains("cloth.png") && Contains("not a scene file"));
+    CHECK_THAT(mixed.refused[1], Contains("folder.toml") && Contains("a folder"));
+    CHECK_THAT(mixed.refused[2], Contains("missing.toml") && Contains("no such file"));
+    CHECK_THAT(mixed.refused[3], Contains("a.toml") && Contains("one scene at a time"));
+
+    const DropChoice none = choose_dropped_scene({picture.string()});
+    CHECK(!none.open);
+    CHECK(none.refused.size() == 1);
+}
+
+TEST_CASE("a dropped scene that does not load changes nothing the user has") {
+    const clothsim::test::TempDir dir("drop_bad");
+    const std::filesystem::path bad = dir / "bad.toml";
+    std::ofstream(bad) << "[cloth]\nrows = -4\n";
+    Session s;
+    const auto positions = s.sim.positions();
+    const double time = s.sim.time();
+    const DropChoice choice = choose_dropped_scene({bad.string()});
+    REQUIRE(choice.open);
+    const auto error = open_scene(*choice.open, s.edited, s.loaded, s.sim);  // what the app does with the drop
+    REQUIRE(error);
+    CHECK_THAT(*error, Contains("bad.toml") && Contains("cloth.rows"));
+    check_untouched(s, positions, time);
 }

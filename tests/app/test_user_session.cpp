@@ -160,8 +160,8 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
     SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its first item)") {
         open_curtain("session_open_combo", "click 110 59\nclick 40 84\n");
     }
-    SECTION("typed into the file field and opened with the Open file button") {
-        open_curtain("session_open_file", "click 115 82\nkey ctrl+a\ntype '" + scene_path("curtain") + "'\nclick 270 82\n");
+    SECTION("typed into the built-in file browser's name field after Open file...") {
+        open_curtain("session_open_file", "click 50 82\ntype '" + scene_path("curtain") + "'\nkey Return\n");
     }
 }
 
@@ -258,7 +258,7 @@ TEST_CASE("user session: typed out-of-range values are clamped with a note, and 
                                          "click 50 381\n"
                                          "ctrl_click 117 565\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
-                                         "click 285 151\nquit\n");
+                                         "click 65 151\nkey Return\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     CHECK_THAT(r.err, Contains("forces.wind") && Contains("out of range") && Contains("springs.damping"));
@@ -288,4 +288,78 @@ TEST_CASE("user session: labels follow the scene, and two F12 presses in a secon
     REQUIRE(r.code == 0);
     CHECK_THAT(r.out, Contains("title before: clothsim - flag") && Contains("title after: clothsim - curtain"));
     CHECK_THAT(r.out, Contains("screenshots: 2"));
+}
+
+TEST_CASE("user session: Open file... shows the desktop's dialog (zenity) and opens the file it returns") {
+    // A stand-in zenity, first on PATH: it records how it was asked and answers with curtain's path.
+    const TempDir dir("session_zenity");
+    fs::create_directories(dir / "bin");
+    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\nprintf '%s\\n' \"$@\" > " << quote((dir / "zenity-args").string())
+                                          << "\necho " << quote(scene_path("curtain")) << "\n";
+    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
+                                         "echo \"title before: $(xdotool getwindowname $wid)\"\n"
+                                         "click 50 82\nsettle\n"
+                                         "echo \"title after: $(xdotool getwindowname $wid)\"\nquit\n",
+                                         "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(read_file(dir / "zenity-args"), Contains("--file-selection") && Contains("*.toml"));
+    CHECK_THAT(r.out, Contains("title before: clothsim - flag") && Contains("title after: clothsim - curtain"));
+    // The opened file is the first of the recent files, kept in the config folder.
+    CHECK(read_file(dir / "config" / "clothsim" / "recent-files") == scene_path("curtain") + "\n");
+}
+
+TEST_CASE("user session: the title marks an edit, Save scene as clears the mark, and the next run opens the file from Recent") {
+    const TempDir dir("session_recent");
+    // Springs' damping typed 0.5 (flag has 1): the title gains its mark; saved, it loses it.
+    const RunResult first = run_user_session(dir, {"--scene", "curtain", "--paused"},
+                                             "echo \"title start: $(xdotool getwindowname $wid)\"\n"
+                                             "ctrl_click 117 289\nkey ctrl+a\ntype 0.5\nkey Return\n"
+                                             "echo \"title edited: $(xdotool getwindowname $wid)\"\n"
+                                             "click 65 151\nkey Return\n"
+                                             "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n");
+    CAPTURE_RUN(first);
+    REQUIRE(first.code == 0);
+    CHECK_THAT(first.out, Contains("title start: clothsim - curtain\n") && Contains("title edited: clothsim - curtain*\n") &&
+                              Contains("title saved: clothsim - curtain\n"));
+    const fs::path saved = dir / "curtain-edited.toml";
+    REQUIRE(fs::exists(saved));
+    CHECK(clothsim::load_scene(saved.string()).settings.springs.damping == 0.5f);
+    CHECK(read_file(dir / "config" / "clothsim" / "recent-files") == saved.string() + "\n");
+
+    // Another run, on flag: the Recent combo (right of Open file...) lists the saved file first.
+    const RunResult second = run_user_session(dir, {"--scene", "flag", "--paused"},
+                                              "click 220 82\nclick 220 106\n"
+                                              "echo \"title: $(xdotool getwindowname $wid)\"\nquit\n");
+    CAPTURE_RUN(second);
+    REQUIRE(second.code == 0);
+    CHECK_THAT(second.out, Contains("title: clothsim - curtain\n"));
+}
+
+TEST_CASE("user session: F9 records every frame into a new folder until F9 again, each a PNG of the window") {
+    const TempDir dir("session_record");
+    const RunResult r = run_user_session(dir, {"--scene", "flag"}, "key F9\nsleep 2\nkey F9\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    std::vector<fs::path> folders;
+    for (const auto& e : fs::directory_iterator(dir.path())) {
+        if (e.path().filename().string().starts_with("clothsim-recording-")) folders.push_back(e.path());
+    }
+    REQUIRE(folders.size() == 1);
+    std::size_t frames = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(folders[0])) ++frames;
+    CHECK(frames >= 3);
+    for (std::size_t n = 1; n <= frames; ++n) {  // numbered 1..N with no gap
+        char name[32];
+        std::snprintf(name, sizeof name, "frame-%06zu.png", n);
+        INFO(name);
+        const Image frame = load_png(folders[0] / name);
+        CHECK(frame.width == kWidth);
+        CHECK(frame.height == kHeight);
+    }
+    const Image first = load_png(folders[0] / "frame-000001.png");
+    char last_name[32];
+    std::snprintf(last_name, sizeof last_name, "frame-%06zu.png", frames);
+    CHECK(differing_pixels(first, load_png(folders[0] / last_name), kViewRect, 30) > 1000);  // the flag moved
 }

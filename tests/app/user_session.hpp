@@ -49,11 +49,14 @@ shot() {
 
 // Runs `clothsim args...` in `dir` on a private X server, waits for its window, runs `actions` (lines of the
 // functions above; end them with quit, or give the app --quit-after), then waits up to 60 s for the app to
-// exit. The result's code is the app's exit code; 90 when no window appeared in 60 s, 91 when no X server started,
+// exit. The app's settings live in dir/config ($XDG_CONFIG_HOME), never the user's; its file dialog is the
+// built-in browser (CLOTHSIM_FILE_DIALOG=imgui) unless `env` (shell assignments, e.g. "PATH=...") says
+// otherwise. The result's code is the app's exit code; 90 when no window appeared in 60 s, 91 when no X server started,
 // 92 when the app did not exit (it is killed).
 inline RunResult run_user_session(const TempDir& dir, const std::vector<std::string>& args,
-                                  const std::string& actions) {
-    std::string command = quote(CLOTHSIM_EXE);
+                                  const std::string& actions, const std::string& env = "") {
+    std::string command = "env XDG_CONFIG_HOME=" + quote((dir / "config").string()) + " CLOTHSIM_FILE_DIALOG=imgui " + env +
+                          " " + quote(CLOTHSIM_EXE);
     for (const std::string& a : args) command.append(" ").append(quote(a));
     const std::filesystem::path script = dir / "session.sh";
     std::ofstream(script) << "set -u\ncd " << quote(dir.path().string()) << "\n"

@@ -257,7 +257,7 @@ TEST_CASE("render every bundled scene: exit 0, a full-size PNG that is not blank
         INFO("scene " << name);
         // The stiff scenes draw fewer frames (tests/support.hpp): the frames are what this test pays for.
         const auto* costly = clothsim::test::costly_scene(name);
-        const Screenshot& shot = screenshot(name, costly ? costly->render_frames : kFrames);
+        const Screenshot& shot = screenshot(name, (costly ? costly->render_frames : kFrames) / clothsim::test::kLoopShare);
         CHECK_THAT(shot.run.out, Contains("wrote ") && Contains("1280x720"));
         CHECK(shot.run.err.empty());
         if (!usable(shot)) continue;

@@ -363,3 +363,23 @@ TEST_CASE("user session: F9 records every frame into a new folder until F9 again
     std::snprintf(last_name, sizeof last_name, "frame-%06zu.png", frames);
     CHECK(differing_pixels(first, load_png(folders[0] / last_name), kViewRect, 30) > 1000);  // the flag moved
 }
+
+TEST_CASE("user session: a .toml dropped onto the window opens, other dropped files and a bad scene are refused, saying why") {
+    const TempDir dir("session_drop");
+    const fs::path curtain = dir / "my curtain.toml", bad = dir / "bad.toml", picture = dir / "cloth.png";
+    fs::copy_file(scene_path("curtain"), curtain);
+    std::ofstream(bad) << "[cloth]\nrows = -4\n";
+    std::ofstream(picture) << "not a scene";
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
+                                         "drop 900 400 " + quote(bad.string()) + "\n"
+                                         "echo \"title bad: $(xdotool getwindowname $wid)\"\n"
+                                         "drop 900 400 " + quote(picture.string()) + " " + quote(curtain.string()) + "\n"
+                                         "echo \"title dropped: $(xdotool getwindowname $wid)\"\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, !Contains("drop: not taken"));
+    CHECK_THAT(r.out, Contains("title bad: clothsim - flag\n") && Contains("title dropped: clothsim - curtain\n"));
+    CHECK_THAT(r.err, Contains("bad.toml") && Contains("cloth.rows"));                      // why the bad scene was refused
+    CHECK_THAT(r.err, Contains("cloth.png: not opened: not a scene file"));                 // and the picture
+    CHECK(read_file(dir / "config" / "clothsim" / "recent-files") == curtain.string() + "\n");  // the path with a space intact
+}

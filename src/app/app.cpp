@@ -560,12 +560,22 @@ std::filesystem::path new_recording_folder(std::string& error) {
     return std::filesystem::absolute(name, ec);
 }
 
+// `text` as one shell word: as it is when it holds only safe characters, else in single quotes.
+std::string shell_word(const std::string& text) {
+    if (text.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789/._-%+=:,") == std::string::npos) {
+        return text;
+    }
+    std::string quoted = "'";
+    for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
 // The one-line ffmpeg command that makes a video of a recording, at its frame rate (1 / dt: one step a frame).
 std::string video_command(const AppState& app, const std::filesystem::path& folder) {
     char rate[32];
     std::snprintf(rate, sizeof rate, "%g", 1.0 / app.sim.settings().integration.dt);
-    return std::string("ffmpeg -framerate ") + rate + " -i " + (folder / "frame-%06d.png").string() +
-           " -pix_fmt yuv420p " + folder.string() + ".mp4";
+    return std::string("ffmpeg -framerate ") + rate + " -i " + shell_word((folder / "frame-%06d.png").string()) +
+           " -pix_fmt yuv420p " + shell_word(folder.string() + ".mp4");
 }
 
 // F9 and the Record button: start recording into a new folder, or stop and say how to make the video.

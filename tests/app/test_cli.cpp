@@ -1,5 +1,6 @@
 // The clothsim executable, run as a user would: flags, exit codes (0 ok, 2 bad input, 3 non-finite), the
 // --json report, the trajectory CSV and the OBJ mesh.
+#include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
 
 #include "run_process.hpp"
@@ -179,6 +180,24 @@ TEST_CASE("cli: a scene given as a path to a .toml file is run") {
     CHECK(j.at("steps") == 10);
     CHECK(j.at("simulated_seconds").get<double>() == Approx(0.1).margin(1e-6));
     CHECK(j.at("substeps_per_step") == 10);
+}
+
+TEST_CASE("cli: the scene may be given without --scene, as a file manager passes a file (clothsim FILE), but not both") {
+    const RunResult r = run_clothsim({(kData / "scene_small.toml").string(), "--headless", "--steps", "10", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK(nlohmann::json::parse(r.out).at("scene") == "small");
+    const RunResult both = run_clothsim({"flag", "--scene", "hanging", "--print-scene"});
+    CHECK(both.code == 2);
+    CHECK_THAT(both.err, Contains("--scene"));
+}
+
+TEST_CASE("cli: --version prints the version and the fast solver's kernel on this CPU, exit 0") {
+    const RunResult r = run_clothsim({"--version"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK(r.out == std::string("clothsim ") + CLOTHSIM_VERSION + " (fast solver kernel: " +
+                       clothsim::MassSpring::fast_kernel_name() + ")\n");
 }
 
 TEST_CASE("cli: --json reports the step profile: every stage, its time, and why a skipped one is skipped") {

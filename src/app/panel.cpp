@@ -454,10 +454,12 @@ void scene_section(AppState& app, PanelRequests& requests) {
     ImGui::SameLine();
     if (app.recording) {
         ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.15f, 0.15f, 1.0f));
-        const std::string label = "Stop recording (F9): " + std::to_string(app.recording->frames) + " frames";
-        if (ImGui::Button(label.c_str())) requests.record = true;
+        if (ImGui::Button("Stop recording (F9)")) requests.record = true;
         ImGui::PopStyleColor();
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("recording every frame to %s", app.recording->folder.c_str());
+        // Where the frames go, while they go there (a line that exists only while recording).
+        ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.4f, 1.0f), "REC %s/ %lld frames",
+                           app.recording->folder.filename().c_str(), app.recording->frames);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", app.recording->folder.c_str());
     } else {
         if (ImGui::Button("Record (F9)")) requests.record = true;
         if (ImGui::IsItemHovered()) {

@@ -159,6 +159,8 @@ int main(int argc, char** argv) {
     skipping->add_option("--repeats", sk.repeats, "Interleaved repetitions (medians)")->check(CLI::Range(1, 1000));
     skipping->add_option("--min-seconds", sk.min_seconds, "Minimum length of one repetition")->check(CLI::PositiveNumber);
     skipping->add_option("--csv", sk.csv, "Write the table as CSV");
+    skipping->add_option("--self-threads", sk.self_threads, "solver.threads of the self-collision cases (0: the scene's)")
+        ->check(CLI::Range(0, 64));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

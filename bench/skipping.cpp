@@ -5,6 +5,7 @@
 
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/self_collision.hpp"
 #include "clothsim/stability.hpp"
 
 #include "per_spring_scenes.hpp"
@@ -18,6 +19,7 @@
 #include <functional>
 #include <iostream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -38,6 +40,7 @@ struct Pair {
     double a_ms = 0.0, b_ms = 0.0;  // median ms per frame
     double ratio = 0.0;    // median of B / A per repetition
     std::string note;
+    int threads = 0;       // the fast solver's threads, where the case sets them
 };
 
 // Times `frame_a` and `frame_b` alternately; each repetition calls `setup` (untimed) before `calls` frames of
@@ -247,15 +250,66 @@ int run_skipping(const SkippingOptions& o) {
                 pairs.push_back(p);
             }
         }
+        // 6. Self-collision (issue 17's targets) at 64 x 64, the scene's own form and auto substeps at 0.7:
+        //    a flat cloth falling (falling, untilted, before it lands) and drape-cube once draped (2.5 s in,
+        //    its corners folded). Both windows restart from the same state, A without collision.self.
+        for (const auto& [scene_name, start, label] : {std::tuple{"falling", 0.0, "self-falling"},
+                                                       std::tuple{"drape-cube", 2.5, "self-drape-cube"}}) {
+            Scene on = load_scene(scene_name);
+            on.cloth.rows = on.cloth.cols = 64;
+            if (std::string(scene_name) == "falling") on.cloth.v_axis = glm::vec3(0.0f, 0.0f, 1.0f);  // flat
+            on.settings.solver.sleep_speed = 0.0f;
+            on.settings.collision.self = true;
+            if (o.self_threads > 0) on.settings.solver.threads = o.self_threads;
+            {
+                const MassSpring probe = build_simulation(on);
+                on.settings.integration.substeps = auto_substeps(stability_limit(probe), on.settings.integration.dt, 0.7f);
+            }
+            Scene off = on;
+            off.settings.collision.self = false;
+            MassSpring b = build_simulation(on);
+            b.run_steps(std::llround(start / on.settings.integration.dt));
+            if (!b.all_finite()) throw std::runtime_error(std::string(scene_name) + " became non-finite");
+            MassSpring a = b;  // the same state, self-collision off
+            a.apply(off.settings);
+            const MassSpring a0 = a, b0 = b;
+            const int frames = 10;
+            auto window = [frames](MassSpring& sim, const MassSpring& from) {
+                sim = from;
+                sim.reset_profile();
+                sim.run_steps(frames);
+            };
+            std::vector<double> self_ms;
+            Pair p = time_pair([&] { window(a, a0); },
+                               [&] {
+                                   window(b, b0);
+                                   self_ms.push_back(b.profile().ms_of(Stage::SelfCollision) / frames);
+                               },
+                               o);
+            p.name = label;
+            p.size = 64;
+            p.threads = b.solver_threads();
+            p.a = "collision.self off";
+            p.b = "collision.self on";
+            char note[200];
+            std::snprintf(note, sizeof note, "self collision stage %.3f ms/frame; %lld of %lld substeps tested, %lld tiles in the narrow phase",
+                          median(self_ms), b.profile().self_tiles / (64 / kSelfTile * 64 / kSelfTile), b.profile().substeps,
+                          b.profile().self_tiles_active);
+            p.note = note;
+            p.a_ms /= frames;
+            p.b_ms /= frames;
+            pairs.push_back(p);
+        }
     } catch (const std::exception& e) {
         std::cerr << "clothsim-bench skipping: error: " << e.what() << "\n";
         return 2;
     }
-    std::printf("%-14s %5s %-20s %-20s %10s %10s %8s  %s\n", "case", "size", "A", "B", "A ms/frame", "B ms/frame",
+    std::printf("%-16s %5s %-20s %-20s %10s %10s %8s  %s\n", "case", "size", "A", "B", "A ms/frame", "B ms/frame",
                 "B / A", "note");
     for (const Pair& p : pairs) {
-        std::printf("%-14s %5d %-20s %-20s %10.4f %10.4f %8.4f  %s\n", p.name.c_str(), p.size, p.a.c_str(), p.b.c_str(),
-                    p.a_ms, p.b_ms, p.ratio, p.note.c_str());
+        const std::string threads = p.threads > 0 ? "; " + std::to_string(p.threads) + " thread(s)" : "";
+        std::printf("%-16s %5d %-20s %-20s %10.4f %10.4f %8.4f  %s%s\n", p.name.c_str(), p.size, p.a.c_str(), p.b.c_str(),
+                    p.a_ms, p.b_ms, p.ratio, p.note.c_str(), threads.c_str());
     }
     if (!o.csv.empty()) {
         std::ofstream out(o.csv);

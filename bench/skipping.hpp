@@ -11,6 +11,7 @@ struct SkippingOptions {
     int repeats = 21;                 // interleaved timed repetitions per pair (medians reported)
     double min_seconds = 0.05;        // minimum length of one repetition
     std::string csv;                  // output CSV
+    int self_threads = 0;             // solver.threads of the self-collision cases (0: the scene's)
 };
 
 int run_skipping(const SkippingOptions& options);

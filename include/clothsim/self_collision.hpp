@@ -28,11 +28,14 @@
 // The narrow phase compares every particle of one tile with every particle of the other (16 x 16, four at
 // a time in float), keeps the pairs within d that share no spring, and resolves them in index order in
 // double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.
-// Skipping: a test that finds nothing within the reach d + (kSelfSkip - 1) d / 2 and no tile bent by more
-// than 50 degrees from a neighbour or near the thresholds above also covers the next kSelfSkip - 1
-// substeps: no particle moves more than d / 4 a substep, so no far tiles can have come within d (for the
-// fold thresholds it allows twice the fastest particle's motion a substep, a heuristic). The stage then
-// costs the motion clamp alone.
+// Skipping (conservative advancement, as Mirtich 1996 and Tang et al. 2009 advance bodies by a bound on
+// their approach): a test that finds nothing also measures the room left, the budget: the smallest gap
+// between far tile boxes within d + kSelfLookAhead d, less d, and how far each fold threshold still is
+// (a diagonal shrinks by at most as much as two particles close in; a vector area and a mean normal change
+// by at most a bound per unit of that, to first order). Each substep then takes the spread of the motions,
+// |max - min| over the particles per component, which bounds how much any two particles closed in, off the
+// budget, and tests again only when it is spent (or after kSelfSkipMax substeps). A cloth that falls or
+// rests as a whole spends almost none. The stage then costs one vectorised pass over the motions.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"
@@ -49,7 +52,8 @@
 namespace clothsim {
 
 inline constexpr int kSelfTile = 4;  // particles along each side of a broad-phase tile
-inline constexpr int kSelfSkip = 8;  // substeps one box test that finds nothing covers
+inline constexpr int kSelfSkipMax = 64;           // substeps one box test that finds nothing covers at most
+inline constexpr double kSelfLookAhead = 8.0;     // far gaps are measured out to d + kSelfLookAhead d
 
 // The cloth's particle spacing: its longest structural rest length (0 without structural springs).
 double particle_spacing(const Topology& topology);
@@ -109,20 +113,21 @@ private:
     std::vector<std::uint32_t> order_;      // tiles sorted by box.lo.x (the last substep's order)
     std::vector<std::uint8_t> active_;      // 1: within d of a far tile; 2: folded (tested with its neighbours)
     std::vector<glm::vec3> normal_;         // grid: each tile's mean normal
+    std::vector<double> area_, diagonals_;  // grid: each tile's |vector area| and |D1| + |D2|
     std::vector<std::uint64_t> tile_pairs_; // (a << 32 | b), a <= b: the tile pairs the narrow phase tests
     std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within d
     std::vector<TilePoints> points_;
     std::vector<std::uint8_t> gathered_;
-    const DVec3Array* positions_ = nullptr; // during mark_active
-    int substeps_to_test_ = 0;              // substeps the last empty box test still covers
-    double tested_distance_ = 0.0;          // the d it was made for
+    double budget_ = 0.0;                   // closing left before the next test (conservative advancement)
+    int skipped_ = 0;                       // substeps skipped since the last test
+    double tested_distance_ = 0.0;          // the d the last test that found nothing was made for (0: none)
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;
     void tile_boxes(const DVec3Array& position);
     // Lists the tile pairs the narrow phase tests: far tiles within d of each other, and each folded tile
-    // with itself and its neighbours. Returns 0 when nothing comes within `reach` and nothing is bent, so
-    // the next substeps may skip the test.
-    std::size_t mark_active(float d, float reach, float fold_slack);
+    // with itself and its neighbours. Returns how many tiles it marked; when none, `budget` is the closing
+    // the next substeps may spend before a test is needed again.
+    std::size_t mark_active(const DVec3Array& position, float d, float reach, double& budget);
     void gather(std::uint32_t t, const State& state, TilePoints& out) const;
 };
 

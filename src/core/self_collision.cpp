@@ -23,6 +23,49 @@ glm::dvec3 vector_area(const DVec3Array& position, const std::array<std::uint32_
     return glm::cross(position.get(corner[3]) - position.get(corner[0]), position.get(corner[1]) - position.get(corner[2]));
 }
 
+// The Euclidean gap between boxes a and b (0 when they overlap): no point of one is nearer the other.
+float box_gap(const Box& a, const Box& b) {
+    const glm::vec3 gap = glm::max(glm::max(b.lo - a.hi, a.lo - b.hi), glm::vec3(0.0f));
+    return glm::length(gap);
+}
+
+// Per component, the smallest and largest motion of this substep (SSE2, two particles at a time; a NaN
+// component may be lost: a cloth that is not finite is the guard's).
+struct MotionRange {
+    glm::dvec3 lo{0.0}, hi{0.0};
+    // A bound on how much any two particles closed in: |m_j - m_i| <= |hi - lo|.
+    double spread() const { return glm::length(hi - lo); }
+    // A bound on any particle's motion.
+    double largest() const { return glm::length(glm::max(glm::abs(lo), glm::abs(hi))); }
+};
+
+MotionRange motion_range(const DVec3Array& motion, std::size_t n) {
+    MotionRange r;
+    if (n == 0) return r;
+    const double* comp[3] = {motion.x.data(), motion.y.data(), motion.z.data()};
+    for (int k = 0; k < 3; ++k) {
+        const double* m = comp[k];
+        // Four independent accumulators each way: the loop runs at the loads' pace, not the min's latency.
+        __m128d lo[2] = {_mm_set1_pd(m[0]), _mm_set1_pd(m[0])}, hi[2] = {lo[0], lo[0]};
+        std::size_t i = 0;
+        for (; i + 4 <= n; i += 4) {
+            const __m128d a = _mm_loadu_pd(m + i), b = _mm_loadu_pd(m + i + 2);
+            lo[0] = _mm_min_pd(lo[0], a);
+            hi[0] = _mm_max_pd(hi[0], a);
+            lo[1] = _mm_min_pd(lo[1], b);
+            hi[1] = _mm_max_pd(hi[1], b);
+        }
+        double l[2], h[2];
+        _mm_storeu_pd(l, _mm_min_pd(lo[0], lo[1]));
+        _mm_storeu_pd(h, _mm_max_pd(hi[0], hi[1]));
+        double mn = std::min(l[0], l[1]), mx = std::max(h[0], h[1]);
+        for (; i < n; ++i) mn = std::min(mn, m[i]), mx = std::max(mx, m[i]);
+        r.lo[k] = mn;
+        r.hi[k] = mx;
+    }
+    return r;
+}
+
 // Whether boxes a and b come within `reach` of each other (per axis).
 bool within(const Box& a, const Box& b, float reach) {
     return a.lo.x <= b.hi.x + reach && b.lo.x <= a.hi.x + reach && a.lo.y <= b.hi.y + reach &&
@@ -175,10 +218,10 @@ void SelfCollision::tile_boxes(const DVec3Array& position) {
     }
 }
 
-// The box test, the fold test and the narrow phase's tile pairs (see the header). `reach` is the distance
-// the far-tile test allows; `strict` says whether the result is for this substep alone (else it must also
-// cover the substeps an empty result skips, so bends count as folds sooner).
-std::size_t SelfCollision::mark_active(float d, float reach, float fold_slack) {
+// The box test, the fold test and the narrow phase's tile pairs (see the header). When it marks nothing it
+// sets `budget`: how far any two particles may close in before the next test is needed (0: test again at
+// the next substep).
+std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, float reach, double& budget) {
     constexpr float kCrumpled = 0.8f;  // box diagonal over rest diagonal below which a region counts as folded
     const std::size_t tiles = boxes_.size();
     // Insertion sort by lo.x from the last substep's order: nearly sorted already, so nearly linear.
@@ -191,72 +234,95 @@ std::size_t SelfCollision::mark_active(float d, float reach, float fold_slack) {
     }
     active_.assign(tiles, 0);
     tile_pairs_.clear();
-    // Far pairs within `within_reach` of each other: listed (and marked) when `list`, else only whether any.
-    auto sweep = [&](float within_reach, bool list) {
-        bool any = false;
-        for (std::size_t k = 0; k < tiles; ++k) {
-            const std::uint32_t a = order_[k];
-            if (boxes_[a].empty()) continue;
-            for (std::size_t m = k + 1; m < tiles; ++m) {
-                const std::uint32_t b = order_[m];
-                if (boxes_[b].lo.x > boxes_[a].hi.x + within_reach) break;
-                if (!within(boxes_[a], boxes_[b], within_reach) || adjacent_tiles(a, b)) continue;
-                if (!list) return true;
-                any = true;
-                active_[a] = active_[b] = 1;
-                tile_pairs_.push_back(pair_key(a, b));
-            }
+    // Far pairs within d of each other.
+    for (std::size_t k = 0; k < tiles; ++k) {
+        const std::uint32_t a = order_[k];
+        if (boxes_[a].empty()) continue;
+        for (std::size_t m = k + 1; m < tiles; ++m) {
+            const std::uint32_t b = order_[m];
+            if (boxes_[b].lo.x > boxes_[a].hi.x + d) break;
+            if (!within(boxes_[a], boxes_[b], d) || adjacent_tiles(a, b)) continue;
+            active_[a] = active_[b] = 1;
+            tile_pairs_.push_back(pair_key(a, b));
         }
-        return any;
-    };
-    sweep(d, true);
-    bool near = false;  // a bend near the fold thresholds: the next substeps cannot be skipped
+    }
     // Folds within a tile or between grid neighbours (Volino & Magnenat-Thalmann 1994: a surface whose
     // normals all lie within a half-space cannot meet itself). A tile is folded when its vector area falls
     // under half its rest area, two neighbours when their mean normals point apart (a hairpin). Such
-    // tiles are tested against themselves and their neighbours. Looking ahead, a tile bent by more than
-    // 50 degrees from a neighbour, or with under 0.7 of its area, already rules out skipping.
+    // tiles are tested against themselves and their neighbours.
+    // Crumpled regions: a tile, or a tile with a neighbour, whose box diagonal (at least the distance
+    // between any two of its particles) falls under 0.8 of its rest diagonal (a fold or an accordion
+    // buckle across tiles that leaves each tile's normal alone).
+    auto box_diagonal = [](const Box& b) { return glm::length(b.hi - b.lo); };
+    auto joined = [](const Box& a, const Box& b) { return Box{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)}; };
+    static constexpr int kDr[5] = {0, 0, 1, 1, 1}, kDc[5] = {0, 1, 0, 1, -1};
+    auto neighbour = [&](std::uint32_t t, int k) {
+        return static_cast<std::uint32_t>((tile_row_[t] + kDr[k]) * tile_cols_ + (tile_col_[t] + kDc[k]));
+    };
     if (grid_) {
         normal_.resize(tiles);
+        area_.resize(tiles);
+        diagonals_.resize(tiles);
         for (std::size_t t = 0; t < tiles; ++t) {
-            const glm::dvec3 area = vector_area(*positions_, corner_[t]);
+            const std::array<std::uint32_t, 4>& corner = corner_[t];
+            const glm::dvec3 d1 = position.get(corner[3]) - position.get(corner[0]);
+            const glm::dvec3 d2 = position.get(corner[1]) - position.get(corner[2]);
+            const glm::dvec3 area = glm::cross(d1, d2);
             const double length = glm::length(area);
+            area_[t] = length;
+            diagonals_[t] = glm::length(d1) + glm::length(d2);
             normal_[t] = length > 0.0 ? glm::vec3(area / length) : glm::vec3(0.0f);
             if (!(length >= 0.5 * rest_area_[t])) active_[t] = 2;  // also NaN
-            if (!(length >= 0.7 * rest_area_[t])) near = true;
         }
-        // Crumpled regions: a tile, or a tile with a neighbour, whose box diagonal (at least the distance
-        // between any two of its particles) falls under 0.8 of its rest diagonal (a fold or an accordion
-        // buckle across tiles that leaves each tile's normal alone).
-        auto box_diagonal = [](const Box& b) { return glm::length(b.hi - b.lo); };
-        auto joined = [](const Box& a, const Box& b) { return Box{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)}; };
-        const float slack = fold_slack;  // looking ahead: the shrinking the skipped substeps may bring
         for (std::uint32_t t = 0; t < tiles; ++t) {
-            const int r = tile_row_[t], c = tile_col_[t];
             const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
-            if (!boxes_[t].empty()) {
-                const float diagonal = box_diagonal(boxes_[t]);
-                if (diagonal < kCrumpled * rest[0]) active_[t] = 2;
-                if (diagonal < kCrumpled * rest[0] + slack) near = true;
-            }
-            const int dr[5] = {0, 0, 1, 1, 1}, dc[5] = {0, 1, 0, 1, -1};
+            if (!boxes_[t].empty() && box_diagonal(boxes_[t]) < kCrumpled * rest[0]) active_[t] = 2;
             for (int k = 1; k < 5; ++k) {
                 if (rest[k] == 0.0f) continue;
-                const std::uint32_t u = static_cast<std::uint32_t>((r + dr[k]) * tile_cols_ + (c + dc[k]));
-                const float cosine = glm::dot(normal_[t], normal_[u]);
-                if (!(cosine >= 0.0f)) active_[t] = active_[u] = 2;
-                if (!(cosine >= 0.64f)) near = true;  // cos 50 degrees
+                const std::uint32_t u = neighbour(t, k);
+                if (!(glm::dot(normal_[t], normal_[u]) >= 0.0f)) active_[t] = active_[u] = 2;
                 if (boxes_[t].empty() || boxes_[u].empty()) continue;
-                const float diagonal = box_diagonal(joined(boxes_[t], boxes_[u]));
-                if (diagonal < kCrumpled * rest[k]) active_[t] = active_[u] = 2;
-                if (diagonal < kCrumpled * rest[k] + slack) near = true;
+                if (box_diagonal(joined(boxes_[t], boxes_[u])) < kCrumpled * rest[k]) active_[t] = active_[u] = 2;
             }
         }
     }
     const bool any_active = std::find_if(active_.begin(), active_.end(), [](std::uint8_t a) { return a != 0; }) != active_.end();
-    // Nothing to test now: the next substeps may be skipped unless something is near (the wider sweep last,
-    // as it costs the most).
-    if (!any_active) return near || sweep(reach, false) ? 1 : 0;
+    if (!any_active) {
+        // The budget: how much any two particles may close in before a test could find something. When no
+        // two particles close in by more than b, far boxes come b nearer at most, a diagonal shrinks by at
+        // most b, a vector area (the cross product of the diagonals D1, D2) by at most b (|D1| + |D2|), and
+        // a mean normal turns by at most 2 b (|D1| + |D2|) / |area| radians (to first order); two normals
+        // with cosine c are at least asin(c) >= c radians from being 90 degrees apart.
+        budget = reach - d;
+        for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
+            budget = std::min(budget, (area_[t] - 0.5 * rest_area_[t]) / diagonals_[t]);
+            const double turn_t = 2.0 * diagonals_[t] / area_[t];
+            const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
+            if (!boxes_[t].empty()) budget = std::min(budget, static_cast<double>(box_diagonal(boxes_[t]) - kCrumpled * rest[0]));
+            for (int k = 1; k < 5; ++k) {
+                if (rest[k] == 0.0f) continue;
+                const std::uint32_t u = neighbour(t, k);
+                const double cosine = glm::dot(normal_[t], normal_[u]);
+                budget = std::min(budget, cosine / (turn_t + 2.0 * diagonals_[u] / area_[u]));
+                if (boxes_[t].empty() || boxes_[u].empty()) continue;
+                budget = std::min(budget, static_cast<double>(box_diagonal(joined(boxes_[t], boxes_[u])) - kCrumpled * rest[k]));
+            }
+        }
+        // Far boxes need be looked for only out to d + the budget the folds leave: a nearer gap lowers it.
+        const float look = static_cast<float>(d + std::max(budget, 0.0));
+        for (std::size_t k = 0; k < tiles && budget > 0.0; ++k) {
+            const std::uint32_t a = order_[k];
+            if (boxes_[a].empty()) continue;
+            for (std::size_t m = k + 1; m < tiles; ++m) {
+                const std::uint32_t b = order_[m];
+                if (boxes_[b].lo.x > boxes_[a].hi.x + look) break;
+                if (!within(boxes_[a], boxes_[b], look) || adjacent_tiles(a, b)) continue;
+                budget = std::min(budget, static_cast<double>(box_gap(boxes_[a], boxes_[b])) - d);
+            }
+        }
+        if (!(budget > 0.0)) budget = 0.0;  // also NaN
+        return 0;
+    }
     std::size_t count = 0;
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (active_[t] == 0) continue;
@@ -313,39 +379,37 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
 
     // No particle moves more than d / 4 in a substep: two layers close by at most d / 2 between checks.
     const double longest = 0.25 * d, longest2 = longest * longest;
-    double fastest2 = 0.0;  // a vectorised pass finds whether any particle needs the clamp
-    for (std::size_t i = 0; i < n; ++i) {
-        const double mx = state.motion.x[i], my = state.motion.y[i], mz = state.motion.z[i];
-        fastest2 = std::max(fastest2, mx * mx + my * my + mz * mz);
-    }
-    for (std::size_t i = 0; i < n && fastest2 > longest2; ++i) {
+    const MotionRange range = motion_range(state.motion, n);  // one vectorised pass
+    bool clamped = false;
+    for (std::size_t i = 0; i < n && !(range.largest() <= longest); ++i) {
         const double mx = state.motion.x[i], my = state.motion.y[i], mz = state.motion.z[i];
         const double m2 = mx * mx + my * my + mz * mz;
         if (!(m2 > longest2)) continue;  // also NaN: left to the guard
         const glm::dvec3 m(mx, my, mz);
-        const glm::dvec3 clamped = m * (longest / std::sqrt(m2));
-        state.position.add(i, clamped - m);
-        state.motion.set(i, clamped);
+        const glm::dvec3 limited = m * (longest / std::sqrt(m2));
+        state.position.add(i, limited - m);
+        state.motion.set(i, limited);
         ++counts.clamped;
+        clamped = true;
     }
 
-    // An empty test covers kSelfSkip substeps: made with the reach d + (kSelfSkip - 1) d / 2, no two far
-    // tiles can have come within d since (each substep closes at most d / 2).
-    if (substeps_to_test_ > 0 && tested_distance_ == d) {
-        --substeps_to_test_;
-        return counts;
+    // Conservative advancement: since the last test that found nothing, no two particles closed in by more
+    // than the sum of this spread of motions, and the test left room for `budget_` of it.
+    if (tested_distance_ == d && !clamped && skipped_ < kSelfSkipMax) {
+        budget_ -= range.spread();
+        if (budget_ > 0.0) {
+            ++skipped_;
+            return counts;
+        }
     }
     tile_boxes(state.position);
     counts.tiles = static_cast<long long>(boxes_.size());
-    positions_ = &state.position;
-    // Folds form from the cloth's own motion: a region shrinks by at most twice its particles' motion a
-    // substep, taken as twice the fastest particle's now (the motion may grow over the skipped substeps).
-    const double fold_slack = 2.0 * (kSelfSkip - 1) * 2.0 * std::min(std::sqrt(fastest2), longest);
-    const std::size_t marked = mark_active(static_cast<float>(d), static_cast<float>(d + 0.5 * (kSelfSkip - 1) * d),
-                                           static_cast<float>(fold_slack));
-    positions_ = nullptr;
+    double budget = 0.0;
+    const std::size_t marked = mark_active(state.position, static_cast<float>(d), static_cast<float>((1.0 + kSelfLookAhead) * d), budget);
+    tested_distance_ = 0.0;
     if (marked == 0) {
-        substeps_to_test_ = kSelfSkip - 1;
+        budget_ = budget;
+        skipped_ = 0;
         tested_distance_ = d;
         return counts;
     }

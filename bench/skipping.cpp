@@ -121,6 +121,15 @@ struct AppFrame {
     }
 };
 
+// One timed window of `frames` frames from the state `from` (restored each time, so a phase stays what it
+// says), with a fresh profile.
+constexpr int kWindowFrames = 10;
+void run_window(MassSpring& sim, const MassSpring& from) {
+    sim = from;
+    sim.reset_profile();
+    sim.run_steps(kWindowFrames);
+}
+
 }  // namespace
 
 int run_skipping(const SkippingOptions& o) {
@@ -217,14 +226,9 @@ int run_skipping(const SkippingOptions& o) {
                 a.run_steps(std::llround(start / on.settings.integration.dt));
                 b.run_steps(std::llround(start / on.settings.integration.dt));
                 if (!a.all_finite() || !b.all_finite()) throw std::runtime_error("the drape became non-finite");
-                // Frames restart from the same state each time, so both phases stay what they say.
                 const MassSpring a0 = a, b0 = b;
-                const int frames = 10;
-                auto window = [frames](MassSpring& sim, const MassSpring& from) {
-                    sim = from;
-                    sim.reset_profile();
-                    sim.run_steps(frames);
-                };
+                const int frames = kWindowFrames;
+                auto window = run_window;
                 std::vector<double> sphere_a, sphere_b;
                 Pair p = time_pair(
                     [&] {
@@ -273,12 +277,8 @@ int run_skipping(const SkippingOptions& o) {
             MassSpring a = b;  // the same state, self-collision off
             a.apply(off.settings);
             const MassSpring a0 = a, b0 = b;
-            const int frames = 10;
-            auto window = [frames](MassSpring& sim, const MassSpring& from) {
-                sim = from;
-                sim.reset_profile();
-                sim.run_steps(frames);
-            };
+            const int frames = kWindowFrames;
+            auto window = run_window;
             std::vector<double> self_ms;
             Pair p = time_pair([&] { window(a, a0); },
                                [&] {

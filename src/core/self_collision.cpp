@@ -234,18 +234,24 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     }
     active_.assign(tiles, 0);
     tile_pairs_.clear();
-    // Far pairs within d of each other.
-    for (std::size_t k = 0; k < tiles; ++k) {
-        const std::uint32_t a = order_[k];
-        if (boxes_[a].empty()) continue;
-        for (std::size_t m = k + 1; m < tiles; ++m) {
-            const std::uint32_t b = order_[m];
-            if (boxes_[b].lo.x > boxes_[a].hi.x + d) break;
-            if (!within(boxes_[a], boxes_[b], d) || adjacent_tiles(a, b)) continue;
-            active_[a] = active_[b] = 1;
-            tile_pairs_.push_back(pair_key(a, b));
+    // The sweep: `visit(a, b)` for every pair of tiles that are not grid neighbours and whose boxes come
+    // within `within_reach` of each other per axis.
+    auto far_pairs = [&](float within_reach, const auto& visit) {
+        for (std::size_t k = 0; k < tiles; ++k) {
+            const std::uint32_t a = order_[k];
+            if (boxes_[a].empty()) continue;
+            for (std::size_t m = k + 1; m < tiles; ++m) {
+                const std::uint32_t b = order_[m];
+                if (boxes_[b].lo.x > boxes_[a].hi.x + within_reach) break;
+                if (within(boxes_[a], boxes_[b], within_reach) && !adjacent_tiles(a, b)) visit(a, b);
+            }
         }
-    }
+    };
+    // Far pairs within d of each other.
+    far_pairs(d, [&](std::uint32_t a, std::uint32_t b) {
+        active_[a] = active_[b] = 1;
+        tile_pairs_.push_back(pair_key(a, b));
+    });
     // Folds within a tile or between grid neighbours (Volino & Magnenat-Thalmann 1994: a surface whose
     // normals all lie within a half-space cannot meet itself). A tile is folded when its vector area falls
     // under half its rest area, two neighbours when their mean normals point apart (a hairpin). Such
@@ -309,16 +315,10 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
             }
         }
         // Far boxes need be looked for only out to d + the budget the folds leave: a nearer gap lowers it.
-        const float look = static_cast<float>(d + std::max(budget, 0.0));
-        for (std::size_t k = 0; k < tiles && budget > 0.0; ++k) {
-            const std::uint32_t a = order_[k];
-            if (boxes_[a].empty()) continue;
-            for (std::size_t m = k + 1; m < tiles; ++m) {
-                const std::uint32_t b = order_[m];
-                if (boxes_[b].lo.x > boxes_[a].hi.x + look) break;
-                if (!within(boxes_[a], boxes_[b], look) || adjacent_tiles(a, b)) continue;
+        if (budget > 0.0) {
+            far_pairs(static_cast<float>(d + budget), [&](std::uint32_t a, std::uint32_t b) {
                 budget = std::min(budget, static_cast<double>(box_gap(boxes_[a], boxes_[b])) - d);
-            }
+            });
         }
         if (!(budget > 0.0)) budget = 0.0;  // also NaN
         return 0;

@@ -312,7 +312,7 @@ TEST_CASE("user session: Open file... shows the desktop's dialog (zenity) and op
 
 TEST_CASE("user session: the title marks an edit, Save scene as clears the mark, and the next run opens the file from Recent") {
     const TempDir dir("session_recent");
-    // Springs' damping typed 0.5 (flag has 1): the title gains its mark; saved, it loses it.
+    // Springs' damping typed 0.5 (curtain has 0.3): the title gains its mark; saved, it loses it.
     const RunResult first = run_user_session(dir, {"--scene", "curtain", "--paused"},
                                              "echo \"title start: $(xdotool getwindowname $wid)\"\n"
                                              "ctrl_click 117 289\nkey ctrl+a\ntype 0.5\nkey Return\n"

@@ -18,7 +18,8 @@ std::filesystem::path executable_path();
 //   programs (build/release/src/clothsim, build/release/tests/fuzz/fuzz_scene) find build/release/share/clothsim,
 //   which the build fills;
 // - else <executable folder>/../share/clothsim/<kind>, where an installed tree would have it, so a message
-//   about a missing file names the place it is expected.
+//   about a missing file names the place it is expected (/usr/share/clothsim/<kind>, the package's, when
+//   the executable's path is unknown).
 std::filesystem::path data_directory(const char* env_var, std::string_view kind);
 
 // The same search from a given executable path (what the tests use).

@@ -37,6 +37,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 namespace clothsim {
 namespace {
 
@@ -293,6 +295,11 @@ void on_drop(GLFWwindow* window, int count, const char** paths) {
 // Files dropped onto the window: the first .toml opens as "Open file" would; the others are refused, said why.
 void handle_drop(AppState& app, InputQueue& input, PanelRequests& requests) {
     if (input.dropped.empty()) return;
+    if (app.dialogs.open()) {  // the dialog's answer would land on top of the dropped scene
+        app.say("dropped files not opened: a file dialog is open; close it first", true);
+        input.dropped.clear();
+        return;
+    }
     const DropChoice choice = choose_dropped_scene(input.dropped);
     input.dropped.clear();
     for (const std::string& why : choice.refused) app.say(why, true);
@@ -308,7 +315,8 @@ void handle_keys(AppState& app, InputQueue& input, PanelRequests& requests) {
     // F12 types nothing: it takes a screenshot even while a text field has the keyboard.
     if (pressed(GLFW_KEY_F12)) requests.screenshot = true;
     if (pressed(GLFW_KEY_F9)) requests.record = true;
-    if (ImGui::GetIO().WantCaptureKeyboard || app.dialogs.browser.is_open()) return;
+    // While a file dialog is open the keys are its own (Escape closes it, never the app behind it).
+    if (ImGui::GetIO().WantCaptureKeyboard || app.dialogs.open()) return;
     if (pressed(GLFW_KEY_SPACE)) app.paused = !app.paused;
     if (pressed(GLFW_KEY_S)) {
         app.paused = true;
@@ -342,13 +350,15 @@ void start_file_dialog(AppState& app, FileDialogMode mode) {
     const std::string name = mode == FileDialogMode::Open ? ""
                              : from_file                  ? std::filesystem::path(app.scene_source).filename().string()
                                                           : app.scene.name + "-edited.toml";
-    if (const auto tool = desktop_dialog_tool()) {
+    const auto tool = app.dialogs.desktop_failed ? std::nullopt : desktop_dialog_tool();
+    if (tool) {
         const std::string error = app.dialogs.desktop.start(dialog_command(*tool, mode, folder, name));
         if (error.empty()) {
             app.dialogs.desktop_mode = mode;
             return;
         }
-        app.say(error + "; using the built-in file browser", true);
+        app.dialogs.desktop_failed = true;
+        app.say(error + "; using the built-in file browser from now on", true);
     }
     app.dialogs.browser.open(mode, folder, name);
 }
@@ -359,14 +369,32 @@ void ask_for(PanelRequests& requests, FileDialogMode mode, const std::string& pa
     else requests.save = path;
 }
 
+// The desktop dialog's file to save: a name typed without .toml gets it, as the built-in browser does, but
+// a file of that new name the dialog never asked about is not replaced. Nothing (and a message) then.
+std::optional<std::string> save_name(AppState& app, const std::string& chosen) {
+    if (std::filesystem::path(chosen).extension() == ".toml") return chosen;
+    const std::string path = chosen + ".toml";
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec)) {
+        app.say("not saved: " + path + " exists; choose it in the dialog to replace it", true);
+        return std::nullopt;
+    }
+    return path;
+}
+
 // The desktop dialog, polled once a frame: its choice, or why it failed (then the built-in browser opens).
 void poll_file_dialog(AppState& app, PanelRequests& requests) {
     if (!app.dialogs.desktop.running()) return;
     const auto result = app.dialogs.desktop.poll();
     if (!result) return;
-    if (result->path) ask_for(requests, app.dialogs.desktop_mode, *result->path);
-    if (!result->error.empty()) {
-        app.say(result->error + "; using the built-in file browser", true);
+    if (result->path && app.dialogs.desktop_mode == FileDialogMode::Save) {
+        if (const auto path = save_name(app, *result->path)) ask_for(requests, FileDialogMode::Save, *path);
+    } else if (result->path) {
+        ask_for(requests, FileDialogMode::Open, *result->path);
+    }
+    if (!result->error.empty()) {  // not tried again this session: the same tool would fail the same way
+        app.dialogs.desktop_failed = true;
+        app.say(result->error + "; using the built-in file browser from now on", true);
         start_file_dialog(app, app.dialogs.desktop_mode);
     }
 }
@@ -592,7 +620,7 @@ void toggle_recording(AppState& app) {
         app.say("not recording: " + error, true);
         return;
     }
-    app.recording = Recording{folder, 0};
+    app.recording = Recording{folder, 0, {}};
     app.say("recording every frame to " + folder.string() + " (one step of integration.dt per frame); F9 stops");
 }
 
@@ -600,6 +628,14 @@ void toggle_recording(AppState& app) {
 // be written stops the recording and says why.
 bool record_frame(AppState& app, glm::ivec2 fb) {
     if (!app.recording) return true;
+    if (app.recording->frames > 0 && fb != app.recording->size) {
+        app.say("recording stopped after " + std::to_string(app.recording->frames) +
+                    " frames: the window changed size (a video's frames share one size); F9 starts a new one",
+                true);
+        app.recording.reset();
+        return true;
+    }
+    app.recording->size = fb;
     const std::filesystem::path file = app.recording->folder / recording_frame_name(app.recording->frames + 1);
     const int level = std::exchange(stbi_write_png_compression_level, 5);
     const int filter = std::exchange(stbi_write_force_png_filter, 1);
@@ -701,7 +737,12 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         apply_requests(app, renderer, window, scale, requests);
         update_title(app, window, title);
     }
-    if (app.recording && !scripted) toggle_recording(app);  // closing the window ends a recording: say where it is
+    if (app.recording && !scripted) {  // closing the window ends a recording: say where it is, on stdout too
+        const std::string folder = app.recording->folder.string();
+        std::cout << "recorded " << app.recording->frames << " frames to " << folder
+                  << "; make a video: " << video_command(app, app.recording->folder) << "\n";
+        app.recording.reset();
+    }
     stop_imgui();
     return exit_code;
 }
@@ -720,6 +761,7 @@ std::string prepare_record_folder(const std::filesystem::path& folder) {
     if (ec || !std::filesystem::is_directory(folder, ec)) {
         return "cannot create the folder" + (ec ? ": " + ec.message() : std::string(": a file has that name"));
     }
+    if (::access(folder.c_str(), W_OK) != 0) return std::string("cannot write frames into the folder: ") + std::strerror(errno);
     if (std::filesystem::exists(folder / recording_frame_name(1), ec)) {
         return "the folder already holds a recording (" + recording_frame_name(1) +
                "); its frames would mix with the new ones: choose a new or empty folder";
@@ -766,7 +808,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
     start_panel(app, options);
     if (!scripted) app.recent = RecentFiles::from_config();  // scripted runs leave the user's list alone
     loaded_from(app, options.scene_source);
-    if (!options.record.empty()) app.recording = Recording{std::filesystem::absolute(options.record), 0};
+    if (!options.record.empty()) app.recording = Recording{std::filesystem::absolute(options.record), 0, {}};
     renderer->set_cloth(app.sim);
     const float scale = window->content_scale();
     reset_camera(app, view_aspect(app, *window, scale));

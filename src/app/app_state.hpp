@@ -10,6 +10,8 @@
 #include "scene_loading.hpp"
 
 #include "clothsim/mass_spring.hpp"
+
+#include <glm/vec2.hpp>
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 #include "clothsim/stepper.hpp"
@@ -114,6 +116,7 @@ struct Grab {
 struct Recording {
     std::filesystem::path folder;
     long long frames = 0;
+    glm::ivec2 size{0};  // the frames' size (framebuffer pixels): a resize ends the recording
 };
 
 // "frame-000001.png", the name of a recording's frame `n` (from 1), as ffmpeg's frame-%06d.png reads them.
@@ -123,6 +126,7 @@ std::string recording_frame_name(long long n);
 struct FileDialogs {
     DesktopDialog desktop;
     FileDialogMode desktop_mode = FileDialogMode::Open;
+    bool desktop_failed = false;  // the desktop's dialog failed once: the built-in browser for the session
     FileBrowser browser;
     bool open() const { return desktop.running() || browser.is_open(); }
 };

@@ -46,17 +46,15 @@ void FileBrowser::go_to(const std::filesystem::path& folder) {
     error_.clear();
     std::vector<std::string> folders, files;
     std::filesystem::directory_iterator it(folder_, std::filesystem::directory_options::skip_permission_denied, ec);
-    if (ec) {
-        error_ = "cannot read " + folder_.string() + ": " + ec.message();
-        return;
-    }
-    for (const auto& entry : it) {
-        const std::string name = entry.path().filename().string();
+    // The error_code forms throughout: a folder removed or unreadable mid-listing is a message, not a throw.
+    for (; !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
         if (name.empty() || name.front() == '.') continue;  // hidden, as every desktop file dialog hides them
         std::error_code e;
-        if (entry.is_directory(e)) folders.push_back(name + "/");
-        else if (entry.path().extension() == ".toml") files.push_back(name);
+        if (it->is_directory(e)) folders.push_back(name + "/");
+        else if (it->path().extension() == ".toml") files.push_back(name);
     }
+    if (ec) error_ = "cannot read " + folder_.string() + ": " + ec.message();
     std::sort(folders.begin(), folders.end(), less_ignoring_case);
     std::sort(files.begin(), files.end(), less_ignoring_case);
     entries_ = std::move(folders);
@@ -143,7 +141,12 @@ std::optional<std::string> FileBrowser::draw(float scale) {
         if (const char* home = std::getenv("HOME")) go_to(home);
     }
     ImGui::SameLine();
-    if (ImGui::Button("Working folder")) go_to(std::filesystem::current_path());
+    if (ImGui::Button("Working folder")) {
+        std::error_code ec;
+        const std::filesystem::path here = std::filesystem::current_path(ec);
+        if (ec) error_ = "the working folder is gone: " + ec.message();
+        else go_to(here);
+    }
     ImGui::TextWrapped("%s", folder_.c_str());
 
     // The folder's entries: a click on a folder goes into it; a click on a file puts its name in the field,

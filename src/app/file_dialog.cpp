@@ -40,6 +40,10 @@ std::optional<std::filesystem::path> desktop_dialog_tool() {
     const char* choice = std::getenv("CLOTHSIM_FILE_DIALOG");
     const std::string want = choice ? choice : "";
     if (want == "imgui") return std::nullopt;
+    // Without a display for it (zenity then exits 1, as for Cancel) the dialog could never show.
+    const char* x11 = std::getenv("DISPLAY");
+    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+    if (!(x11 && *x11) && !(wayland && *wayland)) return std::nullopt;
     if (want == "zenity" || want == "kdialog") return on_path(want.c_str());
     if (auto zenity = on_path("zenity")) return zenity;
     return on_path("kdialog");

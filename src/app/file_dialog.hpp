@@ -16,7 +16,8 @@ namespace clothsim {
 enum class FileDialogMode { Open, Save };
 
 // Which dialog to use: $CLOTHSIM_FILE_DIALOG = "zenity", "kdialog" or "imgui" chooses; unset (or "auto")
-// takes zenity, else kdialog, from $PATH. Returns the tool's path, or nothing for the ImGui browser.
+// takes zenity, else kdialog, from $PATH. Returns the tool's path, or nothing for the ImGui browser (also
+// when neither $DISPLAY nor $WAYLAND_DISPLAY is set: no desktop to show a dialog on).
 std::optional<std::filesystem::path> desktop_dialog_tool();
 
 // The command line that asks `tool` (zenity or kdialog, by its file name) for a scene file: to open, starting

@@ -75,7 +75,8 @@ void add_flags(CLI::App& app, CommandLine& cl) {
     app.add_option("--view", cl.view_items,
                    "App: start with these view options (comma-separated): wireframe, springs=kind, springs=strain, "
                    "particles, no-pins, no-texture, no-shadows, no-panel")
-        ->delimiter(',');
+        ->delimiter(',')
+        ->allow_extra_args(false);  // clothsim --view wireframe SCENE: SCENE is the scene
 }
 
 // --list-scenes and --list-fields; returns true when one was given (and printed).

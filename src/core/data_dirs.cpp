@@ -15,6 +15,7 @@ std::filesystem::path data_directory(const char* env_var, std::string_view kind,
                                      const std::filesystem::path& executable) {
     if (const char* dir = std::getenv(env_var); dir && *dir) return dir;
     const std::filesystem::path data = std::filesystem::path("share") / "clothsim" / kind;
+    if (executable.empty()) return "/usr" / data;  // the system does not say where we are: the .deb's place
     const std::filesystem::path exe_dir = executable.parent_path();
     std::filesystem::path dir = exe_dir;
     for (int up = 0; up <= 2; ++up, dir = dir.parent_path()) {

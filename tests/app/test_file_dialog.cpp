@@ -115,6 +115,7 @@ TEST_CASE("file dialog: polling never blocks while the dialog is open, and closi
 TEST_CASE("file dialog: zenity, then kdialog, from PATH; CLOTHSIM_FILE_DIALOG chooses, imgui means the built-in browser") {
     const TempDir dir("dialog_choice");
     const Env path("PATH", dir.path().string());
+    const Env display("DISPLAY", ":0");
     Env choice("CLOTHSIM_FILE_DIALOG", "auto");
     CHECK(!desktop_dialog_tool());  // neither installed: the ImGui browser
     const auto kdialog = make_tool(dir, "kdialog", "exit 1");
@@ -124,5 +125,10 @@ TEST_CASE("file dialog: zenity, then kdialog, from PATH; CLOTHSIM_FILE_DIALOG ch
     ::setenv("CLOTHSIM_FILE_DIALOG", "kdialog", 1);
     CHECK(desktop_dialog_tool() == kdialog);
     ::setenv("CLOTHSIM_FILE_DIALOG", "imgui", 1);
+    CHECK(!desktop_dialog_tool());
+    // No display at all (a console, ssh without X forwarding): zenity could not show, the browser it is.
+    ::setenv("CLOTHSIM_FILE_DIALOG", "auto", 1);
+    const Env wayland("WAYLAND_DISPLAY", "");
+    ::unsetenv("DISPLAY");
     CHECK(!desktop_dialog_tool());
 }

@@ -274,7 +274,9 @@ TEST_CASE("render every bundled scene: exit 0, a full-size PNG that is not blank
         for (const auto& [colour, n] : colours) most = std::max(most, n);
         const long long pixels = static_cast<long long>(image.width) * image.height;
         INFO(colours.size() << " distinct colours; the most common covers " << most << " of " << pixels << " pixels");
-        CHECK(colours.size() > 500);  // measured 1,650 to 16,000: shading, textures, the grid, the panel's text
+        // Measured 1,650 to 16,000 after the full frames (shading, textures, the grid, the panel's text), 451
+        // for falling after the sanitizer build's quarter (still in the air, edge-on): a blank frame has a few.
+        CHECK(colours.size() > 300);
         CHECK(most < pixels / 2);     // measured 20% to 38% (the ground's grey)
         // The 3D view is not one flat colour either (a clear colour only, or a black frame).
         std::set<int> view_colours;

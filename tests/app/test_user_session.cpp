@@ -383,3 +383,21 @@ TEST_CASE("user session: a .toml dropped onto the window opens, other dropped fi
     CHECK_THAT(r.err, Contains("cloth.png: not opened: not a scene file"));                 // and the picture
     CHECK(read_file(dir / "config" / "clothsim" / "recent-files") == curtain.string() + "\n");  // the path with a space intact
 }
+
+TEST_CASE("user session: while the desktop's dialog is open, Escape and drops are not the app's, and it keeps running") {
+    // A stand-in zenity that takes 3 s to answer, as a user browsing would.
+    const TempDir dir("session_dialog_open");
+    fs::create_directories(dir / "bin");
+    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\nsleep 3\necho " << quote(scene_path("curtain")) << "\n";
+    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    const fs::path dropped = dir / "dropped.toml";
+    fs::copy_file(scene_path("drape-sphere"), dropped);
+    const RunResult r = run_user_session(dir, {"--scene", "flag"},
+                                         "click 50 82\nkey Escape\ndrop 900 400 " + quote(dropped.string()) +
+                                             "\nsleep 3\necho \"title: $(xdotool getwindowname $wid)\"\nquit\n",
+                                         "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("title: clothsim - curtain\n"));  // Escape did not quit; the dialog's answer opened
+    CHECK_THAT(r.err, Contains("dropped files not opened: a file dialog is open"));
+}

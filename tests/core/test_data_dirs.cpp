@@ -65,6 +65,9 @@ TEST_CASE("data_directory: with nothing found it names where an installed tree w
     CHECK(data_directory("CLOTHSIM_TEST_UNSET", "scenes", t.root / "bin/clothsim") ==
           t.root / "share/clothsim/scenes");
     CHECK(data_directory("CLOTHSIM_TEST_UNSET", "scenes", "/clothsim") == "/share/clothsim/scenes");
+    // Where the program is, unknown: the place the package installs to (never a folder relative to the
+    // working directory).
+    CHECK(data_directory("CLOTHSIM_TEST_UNSET", "scenes", "") == "/usr/share/clothsim/scenes");
 }
 
 TEST_CASE("data_directory: this test program finds the build tree's scenes", "[data_dirs]") {

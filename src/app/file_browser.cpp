@@ -190,7 +190,9 @@ std::optional<std::string> FileBrowser::draw(float scale) {
     } else {
         if (!error_.empty()) ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.4f, 1.0f), "%s", error_.c_str());
         else ImGui::TextDisabled("%s", mode_ == FileDialogMode::Save ? "scene files end in .toml" : "scene files (.toml)");
-        if (ImGui::Button(mode_ == FileDialogMode::Save ? "Save" : "Open") || entered) accept(name_);
+        // Return acts wherever the keyboard is, as in a desktop dialog (also before the field has the focus).
+        const bool enter = ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter), false);
+        if (ImGui::Button(mode_ == FileDialogMode::Save ? "Save" : "Open") || entered || enter) accept(name_);
         ImGui::SameLine();
         if (ImGui::Button("Cancel")) close();
     }

@@ -161,7 +161,7 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
         open_curtain("session_open_combo", "click 110 59\nclick 40 84\n");
     }
     SECTION("typed into the built-in file browser's name field after Open file...") {
-        open_curtain("session_open_file", "click 50 82\ntype '" + scene_path("curtain") + "'\nkey Return\n");
+        open_curtain("session_open_file", "click 50 82\nsettle\ntype '" + scene_path("curtain") + "'\nkey Return\n");
     }
 }
 
@@ -258,7 +258,7 @@ TEST_CASE("user session: typed out-of-range values are clamped with a note, and 
                                          "click 50 381\n"
                                          "ctrl_click 117 565\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
-                                         "click 65 151\nkey Return\nquit\n");
+                                         "click 65 151\nsettle\nkey Return\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     CHECK_THAT(r.err, Contains("forces.wind") && Contains("out of range") && Contains("springs.damping"));
@@ -317,7 +317,7 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
                                              "echo \"title start: $(xdotool getwindowname $wid)\"\n"
                                              "ctrl_click 117 289\nkey ctrl+a\ntype 0.5\nkey Return\n"
                                              "echo \"title edited: $(xdotool getwindowname $wid)\"\n"
-                                             "click 65 151\nkey Return\n"
+                                             "click 65 151\nsettle\nkey Return\n"
                                              "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n");
     CAPTURE_RUN(first);
     REQUIRE(first.code == 0);

@@ -61,6 +61,17 @@ std::string scene_path(const std::string& name) {
     return std::string(CLOTHSIM_SOURCE_DIR) + "/assets/scenes/" + name + ".toml";
 }
 
+// A stand-in zenity in dir/bin that answers a save with the file it proposes (as a user pressing Save does),
+// and the environment that puts it first on PATH. The app polls its answer whenever it comes, so a test
+// does not depend on when a dialog has appeared.
+std::string zenity_saving_as_proposed(const TempDir& dir) {
+    fs::create_directories(dir / "bin");
+    std::ofstream(dir / "bin" / "zenity")
+        << "#!/bin/sh\nfor a in \"$@\"; do case \"$a\" in --filename=*) echo \"${a#--filename=}\"; exit 0 ;; esac; done\nexit 1\n";
+    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    return "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"";
+}
+
 }  // namespace
 
 TEST_CASE("user session: clothsim started with no flag draws, runs and quits on Escape with exit 0") {
@@ -258,7 +269,8 @@ TEST_CASE("user session: typed out-of-range values are clamped with a note, and 
                                          "click 50 381\n"
                                          "ctrl_click 117 565\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
-                                         "click 65 151\nsettle\nkey Return\nquit\n");
+                                         "click 65 151\nsettle\nquit\n",
+                                         zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     CHECK_THAT(r.err, Contains("forces.wind") && Contains("out of range") && Contains("springs.damping"));
@@ -317,8 +329,9 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
                                              "echo \"title start: $(xdotool getwindowname $wid)\"\n"
                                              "ctrl_click 117 289\nkey ctrl+a\ntype 0.5\nkey Return\n"
                                              "echo \"title edited: $(xdotool getwindowname $wid)\"\n"
-                                             "click 65 151\nsettle\nkey Return\n"
-                                             "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n");
+                                             "click 65 151\nsettle\n"
+                                             "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n",
+                                             zenity_saving_as_proposed(dir));
     CAPTURE_RUN(first);
     REQUIRE(first.code == 0);
     CHECK_THAT(first.out, Contains("title start: clothsim - curtain\n") && Contains("title edited: clothsim - curtain*\n") &&

@@ -61,15 +61,18 @@ std::string scene_path(const std::string& name) {
     return std::string(CLOTHSIM_SOURCE_DIR) + "/assets/scenes/" + name + ".toml";
 }
 
-// A stand-in zenity in dir/bin that answers a save with the file it proposes (as a user pressing Save does),
-// and the environment that puts it first on PATH. The app polls its answer whenever it comes, so a test
-// does not depend on when a dialog has appeared.
-std::string zenity_saving_as_proposed(const TempDir& dir) {
+// A stand-in zenity in dir/bin running the shell `body`, and the environment that puts it first on PATH.
+// The app polls its answer whenever it comes, so a test does not depend on when a dialog has appeared.
+std::string stand_in_zenity(const TempDir& dir, const std::string& body) {
     fs::create_directories(dir / "bin");
-    std::ofstream(dir / "bin" / "zenity")
-        << "#!/bin/sh\nfor a in \"$@\"; do case \"$a\" in --filename=*) echo \"${a#--filename=}\"; exit 0 ;; esac; done\nexit 1\n";
+    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\n" << body << "\n";
     fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
     return "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"";
+}
+
+// One that answers a save with the file it proposes, as a user pressing Save does.
+std::string zenity_saving_as_proposed(const TempDir& dir) {
+    return stand_in_zenity(dir, "for a in \"$@\"; do case \"$a\" in --filename=*) echo \"${a#--filename=}\"; exit 0 ;; esac; done\nexit 1");
 }
 
 }  // namespace
@@ -305,15 +308,13 @@ TEST_CASE("user session: labels follow the scene, and two F12 presses in a secon
 TEST_CASE("user session: Open file... shows the desktop's dialog (zenity) and opens the file it returns") {
     // A stand-in zenity, first on PATH: it records how it was asked and answers with curtain's path.
     const TempDir dir("session_zenity");
-    fs::create_directories(dir / "bin");
-    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\nprintf '%s\\n' \"$@\" > " << quote((dir / "zenity-args").string())
-                                          << "\necho " << quote(scene_path("curtain")) << "\n";
-    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    const std::string env = stand_in_zenity(dir, "printf '%s\\n' \"$@\" > " + quote((dir / "zenity-args").string()) +
+                                                      "\necho " + quote(scene_path("curtain")));
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
                                          "echo \"title before: $(xdotool getwindowname $wid)\"\n"
                                          "click 50 82\nsettle\n"
                                          "echo \"title after: $(xdotool getwindowname $wid)\"\nquit\n",
-                                         "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"");
+                                         env);
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     CHECK_THAT(read_file(dir / "zenity-args"), Contains("--file-selection") && Contains("*.toml"));
@@ -400,15 +401,13 @@ TEST_CASE("user session: a .toml dropped onto the window opens, other dropped fi
 TEST_CASE("user session: while the desktop's dialog is open, Escape and drops are not the app's, and it keeps running") {
     // A stand-in zenity that takes 3 s to answer, as a user browsing would.
     const TempDir dir("session_dialog_open");
-    fs::create_directories(dir / "bin");
-    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\nsleep 3\necho " << quote(scene_path("curtain")) << "\n";
-    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    const std::string env = stand_in_zenity(dir, "sleep 3\necho " + quote(scene_path("curtain")));
     const fs::path dropped = dir / "dropped.toml";
     fs::copy_file(scene_path("drape-sphere"), dropped);
     const RunResult r = run_user_session(dir, {"--scene", "flag"},
                                          "click 50 82\nkey Escape\ndrop 900 400 " + quote(dropped.string()) +
                                              "\nsleep 3\necho \"title: $(xdotool getwindowname $wid)\"\nquit\n",
-                                         "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"");
+                                         env);
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     CHECK_THAT(r.out, Contains("title: clothsim - curtain\n"));  // Escape did not quit; the dialog's answer opened

@@ -61,8 +61,9 @@ struct CollisionBlocks {
 // particle by particle only on the blocks whose box may touch it (broad_phase.hpp). The boxes are computed
 // here unless the fast solver left them (boxes_current), and a block's box is grown by the farthest push a
 // collider gave one of its particles, so the next collider's test stays conservative.
-// Each collider's time and block counts go to `profile` when it is not null.
-void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
+// Each collider's time and block counts go to `profile` when it is not null. Returns false when no particle
+// was tested against any collider, so none moved.
+bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile);
 
 }  // namespace clothsim

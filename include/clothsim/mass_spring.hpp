@@ -179,9 +179,10 @@ private:
     void step_textbook(double h, StepProfile* profile);
     // `continues`: the state is what the previous substep left (a multistep integrator may use its history).
     void step_velocity_integrator(Integrator integrator, double h, bool continues);
-    void collide(StepProfile* profile);
-    // Returns whether it moved anything.
-    bool collide_self(StepProfile* profile);
+    // Returns false when it moved no particle.
+    bool collide(StepProfile* profile);
+    // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
+    bool collide_self(StepProfile* profile, const MotionBounds* known);
     void limit_strain();
     void limit_speed(double h);
     void tear();
@@ -231,6 +232,7 @@ private:
     StepProfile profile_;
     bool profiling_ = true;
     CollisionBlocks blocks_;     // particle blocks and their boxes for the collision broad phase
+    MotionBounds motion_bounds_; // the fast solver's bounds of this substep's motion, for self-collision
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas

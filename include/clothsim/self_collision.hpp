@@ -78,9 +78,12 @@ public:
     double contact_distance(const CollisionSettings& settings) const;
     double spacing() const { return spacing_; }
 
-    // One substep of the stage on `state` (after integration and the colliders). Returns what it did;
-    // positions or motions changed when contacts or clamped is not 0.
-    SelfCollisionCounts collide(State& state, const CollisionSettings& settings, const DVec3Array& rest_position);
+    // One substep of the stage on `state` (after integration and the colliders). `known`, when not null, is
+    // the bounds of state.motion as it is now (the fast solver's sweep leaves them); otherwise the stage reads
+    // every motion once for them. Returns what it did; positions or motions changed when contacts or clamped
+    // is not 0.
+    SelfCollisionCounts collide(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
+                                const MotionBounds* known = nullptr);
 
     // Whether particles i and j share a spring or a bend (then they never collide).
     bool neighbours(std::uint32_t i, std::uint32_t j) const;

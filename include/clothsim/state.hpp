@@ -6,6 +6,8 @@
 #include "clothsim/settings.hpp"
 #include "clothsim/spring.hpp"
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include <array>
@@ -69,6 +71,25 @@ struct Topology {
         for (const Spring& s : springs) ++spring_count_by_kind[static_cast<int>(s.kind)];
         spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += bends.size();
     }
+};
+
+// Per component, the smallest and largest motion of one substep (pinned and absent particles' zero included).
+// |m_j - m_i| <= |hi - lo| bounds how much any two particles closed in during it, which is what
+// self-collision's conservative advancement spends its budget on (self_collision.hpp). Empty until a particle
+// is included; a NaN component may be lost (a cloth that is not finite is the guard's).
+struct MotionBounds {
+    glm::dvec3 lo{0.0}, hi{0.0};
+    bool empty = true;
+
+    void include(const MotionBounds& other) {
+        if (other.empty) return;
+        lo = empty ? other.lo : glm::min(lo, other.lo);
+        hi = empty ? other.hi : glm::max(hi, other.hi);
+        empty = false;
+    }
+    double spread() const { return glm::length(hi - lo); }
+    // A bound on any particle's motion.
+    double largest() const { return glm::length(glm::max(glm::abs(lo), glm::abs(hi))); }
 };
 
 // The simulation state, in double precision. A substep changes a position by its motion, which at small

@@ -99,6 +99,19 @@ Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t e
     return box;
 }
 
+void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end, MotionBounds& bounds) {
+    if (end <= begin) return;
+    const std::size_t n = end - begin;
+    const double* axes[3] = {motion.x.data() + begin, motion.y.data() + begin, motion.z.data() + begin};
+    for (int a = 0; a < 3; ++a) {
+        double lo = bounds.empty ? INFINITY : bounds.lo[a], hi = bounds.empty ? -INFINITY : bounds.hi[a];
+        (kAvx2 ? bounds_avx2 : bounds_generic)(axes[a], n, lo, hi);
+        bounds.lo[a] = lo;
+        bounds.hi[a] = hi;
+    }
+    bounds.empty = false;
+}
+
 void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out) {
     static_assert(kBlockParticles == 16, "row_bounds_avx2 reduces two vectors per block");
     if (kAvx2) {

@@ -214,9 +214,10 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
     return std::max(deepest * (T(1) + friction), deepest);
 }
 
+// Returns the number of blocks tested: none, and no particle moved.
 template <class Shape>
-void collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
-                    int which, StepProfile* profile) {
+long long collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
+                         int which, StepProfile* profile) {
     long long tested = 0;
     // First the whole cloth: a collider out of its reach costs this one test.
     const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
@@ -241,6 +242,7 @@ void collide_blocks(State& state, const Shape& shape, float thickness, bool broa
         profile->blocks_tested[which] += tested;
         profile->blocks_offered[which] += static_cast<long long>(blocks.count());
     }
+    return tested;
 }
 
 }  // namespace
@@ -272,7 +274,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     if (colliders.cylinder.enabled) collide_shape(state, colliders.cylinder, T(colliders.cylinder.friction), thickness, begin, end);
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
-void collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
+bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
         blocks.start = block_starts(state.size(), 0, 0);
@@ -281,7 +283,7 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     const std::size_t count = blocks.count();
     const bool any =
         colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled || colliders.ground.enabled;
-    if (!any) return;
+    if (!any) return false;
     if (!broad_phase) {
         blocks.boxes.resize(count);  // only counted: every block is tested
         blocks.current = blocks.boxes_current = false;
@@ -312,22 +314,24 @@ void collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.boxes_current = blocks.current = true;
     }
     const float thickness = colliders.thickness;
+    long long tested = 0;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile);
+        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
+        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
     }
     if (colliders.cylinder.enabled) {
         StageTimer timer(profile, Stage::Cylinder);
-        collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), profile);
+        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
+        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
     }
+    return tested > 0;
 }
 
 void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {

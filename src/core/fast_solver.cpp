@@ -174,6 +174,62 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(con
     bend_forces_generic(x, y, z, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
+// The running bounds of a block's motion in eight lanes per component (lane j: columns j, j + 8, ...), so a
+// row widens them with whole vectors and no reduction; the lanes are reduced once, at the end of the block.
+// Layout (FastSolver::Scratch::motion_lanes): lo of component k at [8 k, 8 k + 8), hi at [24 + 8 k, ...).
+void reset_lanes(double* lanes) {
+    std::fill(lanes, lanes + 24, INFINITY);
+    std::fill(lanes + 24, lanes + 48, -INFINITY);
+}
+
+// As MINPD and MAXPD (which return their second operand when either is NaN), a NaN value takes its lane's
+// bound until the lane's next value; the bounds of a cloth that is not finite are the guard's concern.
+void widen_tail(const double* m, int c, int n, double* lo, double* hi) {
+    for (; c < n; ++c) {
+        lo[c & 7] = lo[c & 7] < m[c] ? lo[c & 7] : m[c];
+        hi[c & 7] = hi[c & 7] > m[c] ? hi[c & 7] : m[c];
+    }
+}
+
+MotionBounds reduce_lanes(const double* lanes) {
+    MotionBounds b;
+    for (int k = 0; k < 3; ++k) {
+        const double* lo = lanes + 8 * k;
+        const double* hi = lanes + 24 + 8 * k;
+        b.lo[k] = lo[0], b.hi[k] = hi[0];
+        for (int j = 1; j < 8; ++j) {
+            b.lo[k] = b.lo[k] < lo[j] ? b.lo[k] : lo[j];
+            b.hi[k] = b.hi[k] > hi[j] ? b.hi[k] : hi[j];
+        }
+    }
+    b.empty = false;
+    return b;
+}
+
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) void widen_avx512(const double* m, int n, double* lo,
+                                                                       double* hi) {
+    // maskz with all lanes: the unmasked forms trip GCC 12's -Wuninitialized in its header.
+    __m512d l = _mm512_load_pd(lo), h = _mm512_load_pd(hi);
+    int c = 0;
+    for (; c + 8 <= n; c += 8) {
+        const __m512d v = _mm512_loadu_pd(m + c);
+        l = _mm512_maskz_min_pd(0xFF, l, v), h = _mm512_maskz_max_pd(0xFF, h, v);
+    }
+    _mm512_store_pd(lo, l), _mm512_store_pd(hi, h);
+    widen_tail(m, c, n, lo, hi);
+}
+__attribute__((target("avx2,fma"))) void widen_avx2(const double* m, int n, double* lo, double* hi) {
+    __m256d l0 = _mm256_load_pd(lo), l1 = _mm256_load_pd(lo + 4), h0 = _mm256_load_pd(hi), h1 = _mm256_load_pd(hi + 4);
+    int c = 0;
+    for (; c + 8 <= n; c += 8) {
+        const __m256d a = _mm256_loadu_pd(m + c), b = _mm256_loadu_pd(m + c + 4);
+        l0 = _mm256_min_pd(l0, a), h0 = _mm256_max_pd(h0, a);
+        l1 = _mm256_min_pd(l1, b), h1 = _mm256_max_pd(h1, b);
+    }
+    _mm256_store_pd(lo, l0), _mm256_store_pd(lo + 4, l1), _mm256_store_pd(hi, h0), _mm256_store_pd(hi + 4, h1);
+    widen_tail(m, c, n, lo, hi);
+}
+
 // Asked of the CPU once, on first use.
 FastKernel cpu_best_kernel() {
     static const FastKernel best = [] {
@@ -299,7 +355,7 @@ int FastSolver::effective_threads(int requested) const {
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
-                      double h, std::vector<Box>* row_boxes) {
+                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * (static_cast<std::size_t>(cols_) + 2 * kPad);
@@ -320,14 +376,17 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         team_.reset();
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
-    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr};
+    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
+                                       motion_bounds != nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
     const bool automatic = settings.solver.threads == 0 && blocks > 1;
     const bool single = blocks == 1 || (automatic && team_.next_is_single());
+    if (motion_bounds) *motion_bounds = MotionBounds{};
     if (single) {
         const auto start = std::chrono::steady_clock::now();
         sweep(state, sweep_settings, 0, rows_, scratch_[0], no_boundary_);
         if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
+        if (motion_bounds) *motion_bounds = reduce_lanes(scratch_[0].motion_lanes.data());
         state.substep = h;
         return;
     }
@@ -353,6 +412,9 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         }
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
+    for (int b = 0; motion_bounds && b < blocks; ++b) {
+        if (block_begin(b) < block_begin(b + 1)) motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
+    }
     state.substep = h;
 }
 
@@ -492,6 +554,23 @@ template <unsigned Mask, bool Ext>
     }
 }
 
+// Row i0's motion (cols particles) into the lanes, while the row the update just wrote is in L1.
+template <FastKernel K>
+[[gnu::always_inline]] inline void widen_row(const DVec3Array& motion, std::size_t i0, int cols, double* lanes) {
+    const double* comp[3] = {motion.x.data() + i0, motion.y.data() + i0, motion.z.data() + i0};
+    for (int k = 0; k < 3; ++k) {
+        double* lo = lanes + 8 * k;
+        double* hi = lanes + 24 + 8 * k;
+        if constexpr (K == FastKernel::Avx512) {
+            widen_avx512(comp[k], cols, lo, hi);
+        } else if constexpr (K == FastKernel::Avx2) {
+            widen_avx2(comp[k], cols, lo, hi);
+        } else {
+            widen_tail(comp[k], 0, cols, lo, hi);
+        }
+    }
+}
+
 // Everything the sweep of one row block reads besides the state.
 struct SweepInput {
     const Grid& grid;
@@ -503,6 +582,7 @@ struct SweepInput {
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
     float* window;
     const float* zeros;
+    double* motion_lanes;  // the running bounds of the block's motion (8 lanes), or null when not asked for
 };
 
 template <FastKernel K, unsigned Mask>
@@ -514,6 +594,7 @@ template <FastKernel K, unsigned Mask>
     const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
     const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
+    if (in.motion_lanes) reset_lanes(in.motion_lanes);
     for (int r = std::max(begin - 2, 0); r < end; ++r) {
         const float* current;
         if (in.boundary_slot[r] >= 0) {
@@ -549,6 +630,8 @@ template <FastKernel K, unsigned Mask>
         if (in.row_boxes) {
             row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
         }
+        // Likewise its motion's bounds, for self-collision.
+        if (in.motion_lanes) widen_row<K>(state.motion, i0, grid.cols, in.motion_lanes);
     }
 }
 
@@ -618,7 +701,8 @@ void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int 
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
-                        sweep.row_boxes, scratch.window.data(), zeros_.data()};
+                        sweep.row_boxes, scratch.window.data(), zeros_.data(),
+                        sweep.motion_bounds ? scratch.motion_lanes.data() : nullptr};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);
 }
 

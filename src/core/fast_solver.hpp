@@ -47,9 +47,10 @@ public:
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
     // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
-    // block_starts(rows x cols) after the update.
+    // block_starts(rows x cols) after the update, and `motion_bounds` (when not null) the bounds of every
+    // particle's new motion, each row's taken while it is in L1 (for self-collision, self_collision.hpp).
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
-              double h, std::vector<Box>* row_boxes);
+              double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr);
 
     // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
     // at least 8.
@@ -69,6 +70,9 @@ private:
 
     struct Scratch {
         std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
+        // The running bounds of the motion of the rows this block's sweep updated, when asked for: 8 lanes of
+        // lo and of hi per component (fast_solver.cpp).
+        alignas(64) std::array<double, 48> motion_lanes{};
     };
     struct SweepSettings {
         const SimulationSettings& settings;
@@ -76,6 +80,7 @@ private:
         const Vec3Array* external;
         double h;
         Box* row_boxes;
+        bool motion_bounds;
     };
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);

@@ -150,8 +150,10 @@ void MassSpring::step() {
             step_velocity_integrator(integrator, h, continues);
         } break;
     }
-    collide(profile);
-    const bool self_moved = plan_.self_collision && collide_self(profile);
+    const bool collided = collide(profile);
+    // The fast solver's sweep takes the bounds of the motion it writes; a collider that moved none keeps them.
+    const MotionBounds* known = plan_.path == StepPath::Fast && plan_.self_collision && !collided ? &motion_bounds_ : nullptr;
+    const bool self_moved = plan_.self_collision && collide_self(profile, known);
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
@@ -201,7 +203,8 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
     {
         StageTimer timer(profile, Stage::Fast);
-        fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr);
+        fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr,
+                           plan_.self_collision ? &motion_bounds_ : nullptr);
     }
     blocks_.boxes_current = boxes;
     blocks_.current = false;  // the cloth's box is the union, made by the collision stage
@@ -221,16 +224,16 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
     }
 }
 
-void MassSpring::collide(StepProfile* profile) {
-    if (!plan_.any_collider()) return;
-    collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
+bool MassSpring::collide(StepProfile* profile) {
+    if (!plan_.any_collider()) return false;
+    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.
-bool MassSpring::collide_self(StepProfile* profile) {
+bool MassSpring::collide_self(StepProfile* profile, const MotionBounds* known) {
     StageTimer timer(profile, Stage::SelfCollision);
     if (!self_collision_) self_collision_.emplace(topology_, rest_position_);
-    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_);
+    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_, known);
     if (profile) {
         profile->self_tiles += counts.tiles;
         profile->self_tiles_active += counts.tiles_active;

@@ -29,43 +29,6 @@ float box_gap(const Box& a, const Box& b) {
     return glm::length(gap);
 }
 
-// Per component, the smallest and largest motion of this substep (SSE2, two particles at a time; a NaN
-// component may be lost: a cloth that is not finite is the guard's).
-struct MotionRange {
-    glm::dvec3 lo{0.0}, hi{0.0};
-    // A bound on how much any two particles closed in: |m_j - m_i| <= |hi - lo|.
-    double spread() const { return glm::length(hi - lo); }
-    // A bound on any particle's motion.
-    double largest() const { return glm::length(glm::max(glm::abs(lo), glm::abs(hi))); }
-};
-
-MotionRange motion_range(const DVec3Array& motion, std::size_t n) {
-    MotionRange r;
-    if (n == 0) return r;
-    const double* comp[3] = {motion.x.data(), motion.y.data(), motion.z.data()};
-    for (int k = 0; k < 3; ++k) {
-        const double* m = comp[k];
-        // Four independent accumulators each way: the loop runs at the loads' pace, not the min's latency.
-        __m128d lo[2] = {_mm_set1_pd(m[0]), _mm_set1_pd(m[0])}, hi[2] = {lo[0], lo[0]};
-        std::size_t i = 0;
-        for (; i + 4 <= n; i += 4) {
-            const __m128d a = _mm_loadu_pd(m + i), b = _mm_loadu_pd(m + i + 2);
-            lo[0] = _mm_min_pd(lo[0], a);
-            hi[0] = _mm_max_pd(hi[0], a);
-            lo[1] = _mm_min_pd(lo[1], b);
-            hi[1] = _mm_max_pd(hi[1], b);
-        }
-        double l[2], h[2];
-        _mm_storeu_pd(l, _mm_min_pd(lo[0], lo[1]));
-        _mm_storeu_pd(h, _mm_max_pd(hi[0], hi[1]));
-        double mn = std::min(l[0], l[1]), mx = std::max(h[0], h[1]);
-        for (; i < n; ++i) mn = std::min(mn, m[i]), mx = std::max(mx, m[i]);
-        r.lo[k] = mn;
-        r.hi[k] = mx;
-    }
-    return r;
-}
-
 // Whether boxes a and b come within `reach` of each other (per axis).
 bool within(const Box& a, const Box& b, float reach) {
     return a.lo.x <= b.hi.x + reach && b.lo.x <= a.hi.x + reach && a.lo.y <= b.hi.y + reach &&
@@ -371,7 +334,7 @@ void SelfCollision::gather(std::uint32_t t, const State& state, TilePoints& out)
 }
 
 SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings& settings,
-                                           const DVec3Array& rest_position) {
+                                           const DVec3Array& rest_position, const MotionBounds* known) {
     SelfCollisionCounts counts;
     const double d = contact_distance(settings);
     if (!(d > 0.0) || particles_ != state.size()) return counts;
@@ -379,7 +342,13 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
 
     // No particle moves more than d / 4 in a substep: two layers close by at most d / 2 between checks.
     const double longest = 0.25 * d, longest2 = longest * longest;
-    const MotionRange range = motion_range(state.motion, n);  // one vectorised pass
+    // The fast solver's sweep leaves them when nothing moved a particle since: then no pass is needed here.
+    MotionBounds range;
+    if (known) {
+        range = *known;
+    } else {
+        include_motion(state.motion, 0, n, range);  // one vectorised pass
+    }
     bool clamped = false;
     for (std::size_t i = 0; i < n && !(range.largest() <= longest); ++i) {
         const double mx = state.motion.x[i], my = state.motion.y[i], mz = state.motion.z[i];

@@ -37,8 +37,8 @@ using Clock = std::chrono::steady_clock;
 // The base scene resized. A bundled scene runs in its per-spring form (tests/per_spring_scenes.hpp), the workload
 // the recorded figures measured, so they stay comparable after the scenes moved to [material].
 // Its substeps are set to 0.7 of the critical substep on the resized grid (as --auto-substeps 0.7 does; the
-// timed cost of one substep does not depend on their number): at the file's own substeps, `hanging` resized to 128 x 128 or more becomes non-finite in its first step, and
-// a benchmark would then time NaN arithmetic instead of a cloth.
+// timed cost of one substep does not depend on their number): at the file's own substeps, `hanging` resized
+// to 128 x 128 or more becomes non-finite in its first step, and a benchmark would time NaN arithmetic.
 Scene grid_scene(const std::string& base, int size, SolverMethod method, int threads) {
     Scene s = load_per_spring(base);
     s.cloth.rows = size;

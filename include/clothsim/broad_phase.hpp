@@ -32,8 +32,8 @@ struct Box {
 // Positions are double and boxes float: a bound is rounded to the nearest float, within the tests' margin.
 Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t end);
 
-// `bounds` widened by the motions of particles [begin, end), in double (NaN components are left out). The
-// fast solver takes each row's while the row is in L1; self-collision takes the whole cloth's otherwise.
+// `bounds` widened by the motions of particles [begin, end), in double (NaN components are left out):
+// self-collision's pass when the fast solver's sweep did not leave them (fast_solver.hpp).
 void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end, MotionBounds& bounds);
 
 // The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles.

@@ -151,8 +151,9 @@ void MassSpring::step() {
         } break;
     }
     const bool collided = collide(profile);
-    // The fast solver's sweep takes the bounds of the motion it writes; a collider that moved none keeps them.
-    const MotionBounds* known = plan_.path == StepPath::Fast && plan_.self_collision && !collided ? &motion_bounds_ : nullptr;
+    // With self-collision on, the fast solver's sweep takes the bounds of the motion it writes; they hold while
+    // no collider moved a particle.
+    const MotionBounds* known = plan_.path == StepPath::Fast && !collided ? &motion_bounds_ : nullptr;
     const bool self_moved = plan_.self_collision && collide_self(profile, known);
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {

@@ -100,6 +100,9 @@ public:
     // runs position Verlet), and with how many threads the current settings step.
     bool fast_solver_available() const { return fast_.solver != nullptr; }
     int solver_threads() const;
+    // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
+    // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth).
+    bool last_step_fast() const;
     // Tethers to the pins (tethers.hpp; they act when springs.tether_strain > 0), and how many were at their
     // limit in the last substep.
     std::size_t tether_count() const { return tethers_.size(); }
@@ -207,7 +210,7 @@ private:
 
     // What the iterative integrators keep between substeps (internal to src/core, so held by pointer): the
     // projective solver's factorised matrix and BDF2 history (projective.hpp), XPBD's multipliers
-    // (integrators.hpp). Copies of the simulation copy it.
+    // (integrators.hpp) and its grid form (grid_xpbd.hpp). Copies of the simulation copy it.
     struct IterativeSolvers {
         struct Data;
         std::unique_ptr<Data> data;
@@ -217,7 +220,9 @@ private:
         IterativeSolvers(IterativeSolvers&&) noexcept;
         IterativeSolvers& operator=(IterativeSolvers&&) noexcept;
         ~IterativeSolvers();
-        void invalidate_matrix();  // the projective matrix's inputs changed: factorise again at the next step
+        // The stiffness, the substep, the pins or the topology changed: the projective solver factorises
+        // again and XPBD's grid form is made again, at the next step that uses them.
+        void invalidate();
     };
 
     Topology topology_;

@@ -189,7 +189,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     const Integrator integrator = sim.settings().integration.integrator;
     nlohmann::json solver = {
         {"integrator", integrator_names()[static_cast<int>(integrator)]},
-        {"path", sim.plan().path == StepPath::Fast ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
+        {"path", sim.last_step_fast() ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
         {"threads", sim.solver_threads()},
     };
     if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||

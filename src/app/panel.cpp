@@ -597,8 +597,9 @@ void stats_section(const AppState& app) {
                 app.stats.render_ms);
     ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                 app.sim.time());
-    // The fast solver runs position Verlet; every other integrator uses the shared textbook force path.
-    const bool fast = app.sim.plan().path == StepPath::Fast;
+    // The fast path runs position Verlet (the fast solver) and XPBD (its grid form); every other integrator
+    // uses the shared textbook force path.
+    const bool fast = app.sim.last_step_fast();
     const double per_substep_us = app.stats.substeps_last_frame > 0
                                       ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
                                       : 0.0;

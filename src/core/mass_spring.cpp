@@ -5,6 +5,7 @@
 #include "clothsim/tethers.hpp"
 #include "forces.hpp"
 #include "fast_solver.hpp"
+#include "grid_xpbd.hpp"
 #include "integrators.hpp"
 #include "penalty_contact.hpp"
 #include "projective.hpp"
@@ -76,6 +77,9 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
 struct MassSpring::IterativeSolvers::Data {
     ProjectiveSolver projective;
     XpbdMultipliers xpbd;
+    std::optional<GridXpbd> grid_xpbd;  // XPBD's fast path, made from the topology when it is a grid
+    bool grid_xpbd_current = false;     // grid_xpbd matches the topology and the stiffness
+    bool grid_xpbd_ran = false;         // the last XPBD substep was the grid form's
 };
 MassSpring::IterativeSolvers::IterativeSolvers() : data(std::make_unique<Data>()) {}
 MassSpring::IterativeSolvers::IterativeSolvers(const IterativeSolvers& other)
@@ -87,8 +91,10 @@ MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(const Iter
 MassSpring::IterativeSolvers::IterativeSolvers(IterativeSolvers&&) noexcept = default;
 MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(IterativeSolvers&&) noexcept = default;
 MassSpring::IterativeSolvers::~IterativeSolvers() = default;
-void MassSpring::IterativeSolvers::invalidate_matrix() {
-    if (data) data->projective.invalidate_matrix();
+void MassSpring::IterativeSolvers::invalidate() {
+    if (!data) return;
+    data->projective.invalidate_matrix();
+    data->grid_xpbd_current = false;
 }
 
 MassSpring::~MassSpring() = default;
@@ -105,6 +111,12 @@ int MassSpring::solver_threads() const {
     return set_aside ? 1 : fast_.solver->effective_threads(settings_.solver.threads);
 }
 
+bool MassSpring::last_step_fast() const {
+    if (plan_.path == StepPath::Fast) return true;
+    return settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd &&
+           iterative_.data->grid_xpbd_ran;
+}
+
 double MassSpring::substep_length() const {
     return static_cast<double>(settings_.integration.dt) / settings_.integration.substeps;
 }
@@ -113,7 +125,7 @@ void MassSpring::apply(const SimulationSettings& settings) {
     if (settings == settings_) return;
     // The projective solver's matrix holds the stiffness, the substep and the damping.
     if (settings.springs != settings_.springs || settings.integration != settings_.integration) {
-        iterative_.invalidate_matrix();
+        iterative_.invalidate();
     }
     settings_ = settings;
     replan();
@@ -262,7 +274,7 @@ void MassSpring::topology_changed(std::size_t removed) {
     if (removed == 0) return;
     broken_springs_ += removed;
     build_fast_solver();
-    iterative_.invalidate_matrix();
+    iterative_.invalidate();
     if (self_collision_) self_collision_->update_neighbours(topology_);
     rebuild_tethers();
     replan();
@@ -402,10 +414,22 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
             last_iterations_ = solve.iterations;
             last_residual_ = solve.residual;
         } break;
-        case Integrator::Xpbd:
-            step_xpbd(state_, dynamics, topology_, settings_.springs, h, iterative_.data->xpbd);
+        case Integrator::Xpbd: {
+            // The grid form on a grid cloth with solver.method = "fast", the list order otherwise.
+            IterativeSolvers::Data& data = *iterative_.data;
+            if (settings_.solver.method == SolverMethod::Fast && !data.grid_xpbd_current) {
+                data.grid_xpbd = GridXpbd::for_topology(topology_);
+                if (data.grid_xpbd) data.grid_xpbd->set_stiffness(topology_, settings_.springs);
+                data.grid_xpbd_current = true;
+            }
+            data.grid_xpbd_ran = settings_.solver.method == SolverMethod::Fast && data.grid_xpbd.has_value();
+            if (data.grid_xpbd_ran) {
+                data.grid_xpbd->step(state_, dynamics, h);
+            } else {
+                step_xpbd(state_, dynamics, topology_, settings_.springs, h, data.xpbd);
+            }
             last_iterations_ = 1;
-            break;
+        } break;
         case Integrator::Projective: {
             // Wind, contact and a grab are held at their value at the start of the substep.
             external(state_, force_);
@@ -493,7 +517,9 @@ glm::vec3 MassSpring::grab_force(const State& state) const {
 // itself pays nothing for it.
 double MassSpring::last_solver_residual() const {
     if (settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd) {
-        return xpbd_residual(state_.position, topology_, settings_.springs, iterative_.data->xpbd);
+        const IterativeSolvers::Data& data = *iterative_.data;
+        if (data.grid_xpbd_ran) return data.grid_xpbd->residual(state_.position);
+        return xpbd_residual(state_.position, topology_, settings_.springs, data.xpbd);
     }
     return last_residual_;
 }
@@ -593,7 +619,7 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
-    iterative_.invalidate_matrix();  // its matrix is over the free particles
+    iterative_.invalidate();  // its matrix is over the free particles
     rebuild_tethers();  // the pins the cloth hangs from changed
     replan();
 }

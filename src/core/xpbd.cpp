@@ -24,7 +24,9 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         state.position.add(i, state.motion.get(i) + a.get(i) * (h * h));  // x + h (v + h a)
     }
     // One Gauss-Seidel pass over the springs; with lambda starting at 0 each substep,
-    // d_lambda = -C / (w_a + w_b + 1 / (k h^2)).
+    // d_lambda = -C / (w_a + w_b + alpha~), alpha~ = 1 / (k h^2), and x_a -= w_a lambda n, x_b += w_b lambda n with
+    // n = d / |d|, computed as lambda / |d| times d. GridXpbd (grid_xpbd.hpp) does the same arithmetic in
+    // another order.
     multipliers.spring.assign(topology.springs.size(), 0.0);
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
     double violation2 = 0.0;
@@ -34,14 +36,15 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         if (k == 0.0) continue;
         const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
         const glm::dvec3 d = state.position.get(s.b) - state.position.get(s.a);
-        const double length = glm::length(d);
+        const double length = std::sqrt((d.x * d.x + d.y * d.y) + d.z * d.z);
         if (!(length > 1e-12)) continue;
-        const glm::dvec3 normal = d / length;
-        const double lambda = -(length - s.rest_length) / (wa + wb + 1.0 / (k * h * h));
+        const double c = length - static_cast<double>(s.rest_length);
+        const double lambda = -c / ((wa + wb) + 1.0 / (k * h * h));
         multipliers.spring[j] = lambda;
-        violation2 += (length - s.rest_length) * (length - s.rest_length);
-        state.position.add(s.a, -wa * lambda * normal);
-        state.position.add(s.b, wb * lambda * normal);
+        violation2 += c * c;
+        const double g = lambda / length;
+        state.position.add(s.a, d * -(wa * g));
+        state.position.add(s.b, d * (wb * g));
     }
     // Bends: the vector constraint C = x_a - 2 x_m + x_b with compliance 1 / (k h^2) and gradients I, -2 I, I:
     // d_lambda = -C / (w_a + 4 w_m + w_b + 1 / (k h^2)).
@@ -51,11 +54,11 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         if (k == 0.0) continue;
         const double wa = state.inverse_mass[b.a], wm = state.inverse_mass[b.m], wb = state.inverse_mass[b.b];
         const glm::dvec3 c = bend_difference(state.position, b);
-        const glm::dvec3 lambda = -c / (wa + 4.0 * wm + wb + 1.0 / (k * h * h));
+        const glm::dvec3 lambda = c * (-1.0 / (((wa + 4.0 * wm) + wb) + 1.0 / (k * h * h)));
         multipliers.bend[j] = lambda;
-        violation2 += glm::dot(c, c);
+        violation2 += (c.x * c.x + c.y * c.y) + c.z * c.z;
         state.position.add(b.a, wa * lambda);
-        state.position.add(b.m, -2.0 * wm * lambda);
+        state.position.add(b.m, (-2.0 * wm) * lambda);
         state.position.add(b.b, wb * lambda);
     }
     for (std::size_t i = 0; i < n; ++i) {

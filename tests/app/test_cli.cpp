@@ -85,7 +85,7 @@ void expect_bad_input(const std::vector<std::string>& args, std::initializer_lis
 // --json
 // ---------------------------------------------------------------------------------------------------------
 
-TEST_CASE("cli: --json says which solver ran and, for implicit Euler, its CG iterations and the residual it reached") {
+TEST_CASE("cli: --json says which solver ran and, for implicit Euler and XPBD, their iterations and the residual they reached") {
     const RunResult fast = run_clothsim({"--headless", "--steps", "2", "--set", "solver.threads=1", "--json"});
     CAPTURE_RUN(fast);
     REQUIRE(fast.code == 0);
@@ -106,6 +106,20 @@ TEST_CASE("cli: --json says which solver ran and, for implicit Euler, its CG ite
     // CG stops once the relative residual is under the tolerance (or at its iteration cap, far away here).
     CHECK(implicit.at("residual").get<double>() <= 1e-4);
     CHECK(implicit.at("residual").get<double>() >= 0.0);
+    // XPBD runs its grid form on the fast path (grid_xpbd.hpp), and the list order when the textbook is asked for.
+    for (const char* method : {"fast", "textbook"}) {
+        const RunResult x = run_clothsim({"--headless", "--steps", "2", "--set", "cloth.rows=12", "--set",
+                                          "cloth.cols=12", "--set", "integration.integrator=xpbd", "--set",
+                                          std::string("solver.method=") + method, "--json"});
+        CAPTURE_RUN(x);
+        REQUIRE(x.code == 0);
+        const nlohmann::json xpbd = nlohmann::json::parse(x.out).at("solver");
+        CHECK(xpbd.at("integrator") == "xpbd");
+        CHECK(xpbd.at("path") == (std::string(method) == "fast" ? "fast" : "velocity integrator"));
+        CHECK(xpbd.at("iterations") == 1);
+        CHECK(xpbd.at("residual").get<double>() > 0.0);
+        CHECK(xpbd.at("residual").get<double>() < 1.0);
+    }
 }
 
 TEST_CASE("cli: --headless --json prints only a JSON report on stdout") {

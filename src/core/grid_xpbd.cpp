@@ -1,0 +1,422 @@
+#include "grid_xpbd.hpp"
+
+#include "fast_solver.hpp"
+#include "forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace clothsim {
+namespace {
+
+struct Direction {
+    int dr, dc;
+};
+// fast_solver.cpp's order: structural along and down, the two diagonals, two apart along and down.
+constexpr std::array<Direction, 6> kDirections = {{{0, 1}, {1, 0}, {1, 1}, {1, -1}, {0, 2}, {2, 0}}};
+constexpr double kInfinite = std::numeric_limits<double>::infinity();
+
+// Where the particles are and how easily they move.
+struct Particles {
+    double* x;
+    double* y;
+    double* z;
+    const float* w;  // inverse mass, 0 for pinned and absent particles
+};
+
+// One batch of springs i -> i + offset for i = first ... last - 1 that share no particle (a row's springs down).
+// The arithmetic is step_xpbd's: d = x_b - x_a, |d| = sqrt((dx dx + dy dy) + dz dz),
+// lambda = -(|d| - L0) / ((w_a + w_b) + alpha), g = lambda / |d|, x_a -= w_a g d, x_b += w_b g d; nothing
+// for a spring without stiffness (alpha infinite) or whose ends coincide. Returns the sum of C^2.
+[[gnu::always_inline]] inline double project_springs(const Particles& p, const float* rest, const double* alpha,
+                                                     double* lambda, int first, int last, int offset) {
+    double* x = p.x;
+    double* y = p.y;
+    double* z = p.z;
+    const float* w = p.w;
+    double violation2 = 0.0;
+#pragma omp simd reduction(+ : violation2)
+    for (int i = first; i < last; ++i) {
+        const int j = i + offset;
+        const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
+        const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
+        const double c = length - static_cast<double>(rest[i]);
+        const double wa = w[i], wb = w[j];
+        const double l = -c / ((wa + wb) + alpha[i]);
+        const bool ok = (length > 1e-12) & (alpha[i] < kInfinite);
+        const double g = ok ? l / length : 0.0;
+        lambda[i] = ok ? l : 0.0;
+        violation2 += ok ? c * c : 0.0;
+        const double ga = -(wa * g), gb = wb * g;
+        x[i] += dx * ga;
+        y[i] += dy * ga;
+        z[i] += dz * ga;
+        x[j] += dx * gb;
+        y[j] += dy * gb;
+        z[j] += dz * gb;
+    }
+    return violation2;
+}
+
+// One batch of bends (i, i + offset, i + 2 offset) that share no particle (a row's bends down), as step_xpbd: c = (x_a - x_m) + (x_b - x_m),
+// lambda = c * (-1 / (((w_a + 4 w_m) + w_b) + alpha)), x_a += w_a lambda, x_m += -2 w_m lambda, x_b += w_b lambda.
+[[gnu::always_inline]] inline double project_bends(const Particles& p, const double* alpha, double* lx, double* ly,
+                                                   double* lz, int first, int last, int offset) {
+    double* x = p.x;
+    double* y = p.y;
+    double* z = p.z;
+    const float* w = p.w;
+    double violation2 = 0.0;
+#pragma omp simd reduction(+ : violation2)
+    for (int i = first; i < last; ++i) {
+        const int m = i + offset, b = i + 2 * offset;
+        const double cx = (x[i] - x[m]) + (x[b] - x[m]);
+        const double cy = (y[i] - y[m]) + (y[b] - y[m]);
+        const double cz = (z[i] - z[m]) + (z[b] - z[m]);
+        const double wa = w[i], wm = w[m], wb = w[b];
+        const double s = -1.0 / (((wa + 4.0 * wm) + wb) + alpha[i]);
+        const bool ok = alpha[i] < kInfinite;
+        violation2 += ok ? (cx * cx + cy * cy) + cz * cz : 0.0;
+        const double ax = cx * s, ay = cy * s, az = cz * s;
+        lx[i] = ax, ly[i] = ay, lz[i] = az;
+        const double wm2 = -2.0 * wm;
+        x[i] += wa * ax, y[i] += wa * ay, z[i] += wa * az;
+        x[m] += wm2 * ax, y[m] += wm2 * ay, z[m] += wm2 * az;
+        x[b] += wb * ax, y[b] += wb * ay, z[b] += wb * az;
+    }
+    return violation2;
+}
+
+
+// Corrections of one row's elements along the row, before they are added: for the element starting in column
+// c, to its first particle at a[c], to its middle one (a bend's) at m[c + 1], to its last at b[c + span].
+// Every other entry is 0, so each particle's sum adds one correction and zeros.
+struct RowCorrections {
+    double *ax, *ay, *az, *mx, *my, *mz, *bx, *by, *bz;
+    const int* column;  // 0, 1, 2, ...: the column, for the phase test
+};
+
+// The springs along row `row` from column c to c + Span whose column is `phase` modulo Span + 1: no two share a
+// particle. A projection along a row is a chain, so the row is computed whole (vectorised) with the other
+// phases' corrections set to 0, and then added particle by particle. Arithmetic as project_springs.
+template <int Span>
+[[gnu::always_inline]] inline double project_row_springs(const Particles& p, const float* rest, const double* alpha,
+                                                         double* lambda, int row, int cols, int phase,
+                                                         const RowCorrections& t) {
+    double* x = p.x + row;
+    double* y = p.y + row;
+    double* z = p.z + row;
+    const float* w = p.w + row;
+    rest += row, alpha += row, lambda += row;
+    const int* column = t.column;
+    double* ax = t.ax;
+    double* ay = t.ay;
+    double* az = t.az;
+    double* bx = t.bx + Span;
+    double* by = t.by + Span;
+    double* bz = t.bz + Span;
+    double violation2 = 0.0;
+    const int n = cols - Span;
+#pragma omp simd reduction(+ : violation2)
+    for (int c = 0; c < n; ++c) {
+        const double dx = x[c + Span] - x[c], dy = y[c + Span] - y[c], dz = z[c + Span] - z[c];
+        const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
+        const double e = length - static_cast<double>(rest[c]);
+        const double wa = w[c], wb = w[c + Span];
+        const double l = -e / ((wa + wb) + alpha[c]);
+        const bool mine = column[c] % (Span + 1) == phase;
+        const bool ok = mine & (length > 1e-12) & (alpha[c] < kInfinite);
+        const double g = ok ? l / length : 0.0;
+        lambda[c] = mine ? (ok ? l : 0.0) : lambda[c];
+        violation2 += ok ? e * e : 0.0;
+        const double ga = -(wa * g), gb = wb * g;
+        ax[c] = dx * ga, ay[c] = dy * ga, az[c] = dz * ga;
+        bx[c] = dx * gb, by[c] = dy * gb, bz[c] = dz * gb;
+    }
+    for (int c = std::max(n, 0); c < cols; ++c) t.ax[c] = t.ay[c] = t.az[c] = 0.0;  // no element starts there
+    for (int c = 0; c < std::min(Span, cols); ++c) t.bx[c] = t.by[c] = t.bz[c] = 0.0;  // ... or ends there
+#pragma omp simd
+    for (int c = 0; c < cols; ++c) {
+        x[c] += t.ax[c] + t.bx[c];
+        y[c] += t.ay[c] + t.by[c];
+        z[c] += t.az[c] + t.bz[c];
+    }
+    return violation2;
+}
+
+// The bends along row `row` (columns c, c + 1, c + 2) whose first column is `phase` modulo 3, as
+// project_row_springs; arithmetic as project_bends.
+[[gnu::always_inline]] inline double project_row_bends(const Particles& p, const double* alpha, double* lx, double* ly,
+                                                       double* lz, int row, int cols, int phase, const RowCorrections& t) {
+    double* x = p.x + row;
+    double* y = p.y + row;
+    double* z = p.z + row;
+    const float* w = p.w + row;
+    alpha += row, lx += row, ly += row, lz += row;
+    const int* column = t.column;
+    double* ax = t.ax;
+    double* ay = t.ay;
+    double* az = t.az;
+    double* mx = t.mx + 1;
+    double* my = t.my + 1;
+    double* mz = t.mz + 1;
+    double* bx = t.bx + 2;
+    double* by = t.by + 2;
+    double* bz = t.bz + 2;
+    double violation2 = 0.0;
+    const int n = cols - 2;
+#pragma omp simd reduction(+ : violation2)
+    for (int c = 0; c < n; ++c) {
+        const double cx = (x[c] - x[c + 1]) + (x[c + 2] - x[c + 1]);
+        const double cy = (y[c] - y[c + 1]) + (y[c + 2] - y[c + 1]);
+        const double cz = (z[c] - z[c + 1]) + (z[c + 2] - z[c + 1]);
+        const double wa = w[c], wm = w[c + 1], wb = w[c + 2];
+        const bool mine = column[c] % 3 == phase;
+        const double s = mine ? -1.0 / (((wa + 4.0 * wm) + wb) + alpha[c]) : 0.0;
+        const bool ok = mine & (alpha[c] < kInfinite);
+        violation2 += ok ? (cx * cx + cy * cy) + cz * cz : 0.0;
+        const double lax = cx * s, lay = cy * s, laz = cz * s;
+        lx[c] = mine ? lax : lx[c];
+        ly[c] = mine ? lay : ly[c];
+        lz[c] = mine ? laz : lz[c];
+        const double wm2 = -2.0 * wm;
+        ax[c] = wa * lax, ay[c] = wa * lay, az[c] = wa * laz;
+        mx[c] = wm2 * lax, my[c] = wm2 * lay, mz[c] = wm2 * laz;
+        bx[c] = wb * lax, by[c] = wb * lay, bz[c] = wb * laz;
+    }
+    for (int c = std::max(n, 0); c < cols; ++c) t.ax[c] = t.ay[c] = t.az[c] = 0.0;  // no bend starts there,
+    for (int c : {0, cols - 1}) t.mx[c] = t.my[c] = t.mz[c] = 0.0;     // has its middle there
+    for (int c = 0; c < std::min(2, cols); ++c) t.bx[c] = t.by[c] = t.bz[c] = 0.0;     // or ends there
+#pragma omp simd
+    for (int c = 0; c < cols; ++c) {
+        x[c] += (t.ax[c] + t.mx[c]) + t.bx[c];
+        y[c] += (t.ay[c] + t.my[c]) + t.by[c];
+        z[c] += (t.az[c] + t.mz[c]) + t.bz[c];
+    }
+    return violation2;
+}
+
+// What one projection pass needs.
+struct Pass {
+    Particles p;
+    int rows, cols;
+    bool bends;
+    const std::array<bool, 6>* present;
+    const std::array<std::vector<float>, 6>* rest;
+    const std::array<std::vector<double>, 6>* alpha;
+    std::array<std::vector<double>, 6>* lambda;
+    std::array<DVec3Array, 2>* bend_lambda;
+    RowCorrections row;
+};
+
+// Every element once, in the order of the header; returns the sum of C^2.
+[[gnu::always_inline]] inline double project_all(const Pass& pass) {
+    const int rows = pass.rows, cols = pass.cols;
+    double violation2 = 0.0;
+    auto springs = [&](int d, int first, int last) {
+        violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                              (*pass.lambda)[d].data(), first, last,
+                                              kDirections[d].dr * cols + kDirections[d].dc);
+    };
+    const std::array<bool, 6>& present = *pass.present;
+    if (present[0]) {
+        for (int r = 0; r < rows; ++r) {
+            for (int phase = 0; phase < 2; ++phase) {
+                violation2 += project_row_springs<1>(pass.p, (*pass.rest)[0].data(), (*pass.alpha)[0].data(),
+                                                     (*pass.lambda)[0].data(), r * cols, cols, phase, pass.row);
+            }
+        }
+    }
+    for (int d = 1; d <= 3; ++d) {
+        if (!present[d]) continue;
+        for (int r = 0; r + 1 < rows; ++r) {
+            const int row = r * cols;
+            springs(d, row + (d == 3 ? 1 : 0), row + cols - (d == 2 ? 1 : 0));
+        }
+    }
+    if (!pass.bends && present[4]) {
+        for (int r = 0; r < rows; ++r) {
+            for (int phase = 0; phase < 3; ++phase) {
+                violation2 += project_row_springs<2>(pass.p, (*pass.rest)[4].data(), (*pass.alpha)[4].data(),
+                                                     (*pass.lambda)[4].data(), r * cols, cols, phase, pass.row);
+            }
+        }
+    }
+    if (!pass.bends && present[5]) {
+        for (int r = 0; r + 2 < rows; ++r) springs(5, r * cols, r * cols + cols);
+    }
+    if (!pass.bends) return violation2;
+    auto bends = [&](int k, int first, int last) {
+        DVec3Array& l = (*pass.bend_lambda)[k];
+        violation2 += project_bends(pass.p, (*pass.alpha)[4 + k].data(), l.x.data(), l.y.data(),
+                                            l.z.data(), first, last, k == 0 ? 1 : cols);
+    };
+    if (present[4]) {
+        DVec3Array& l = (*pass.bend_lambda)[0];
+        for (int r = 0; r < rows; ++r) {
+            for (int phase = 0; phase < 3; ++phase) {
+                violation2 += project_row_bends(pass.p, (*pass.alpha)[4].data(), l.x.data(), l.y.data(), l.z.data(),
+                                                r * cols, cols, phase, pass.row);
+            }
+        }
+    }
+    if (present[5]) {
+        for (int r = 0; r + 2 < rows; ++r) bends(1, r * cols, r * cols + cols);
+    }
+    return violation2;
+}
+
+// The kernels: one pass compiled for each instruction set, chosen as the fast solver chooses its own. The
+// core compiles without contraction into fused multiply-adds, so all three round alike.
+double project_generic(const Pass& pass) { return project_all(pass); }
+__attribute__((target("avx2,fma"))) double project_avx2(const Pass& pass) { return project_all(pass); }
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) double project_avx512(const Pass& pass) {
+    return project_all(pass);
+}
+
+}  // namespace
+
+std::optional<GridXpbd> GridXpbd::for_topology(const Topology& topology) {
+    const int rows = topology.rows, cols = topology.cols;
+    if (rows <= 0 || cols <= 0) return std::nullopt;
+    const std::size_t n = static_cast<std::size_t>(rows) * cols;
+    GridXpbd grid(rows, cols);
+    grid.bends_ = !topology.bends.empty();
+    for (auto& s : grid.source_) s.assign(n, -1);
+    // The direction and start particle of the element from a to b; -1 when it is none of the six.
+    auto place = [&](std::uint32_t a, std::uint32_t b, int first_direction, int last_direction) -> std::pair<int, std::uint32_t> {
+        if (a >= n || b >= n) return {-1, 0};
+        const int dr = static_cast<int>(b / cols) - static_cast<int>(a / cols);
+        const int dc = static_cast<int>(b % cols) - static_cast<int>(a % cols);
+        for (int d = first_direction; d <= last_direction; ++d) {
+            if (dr == kDirections[d].dr && dc == kDirections[d].dc) return {d, a};
+            if (dr == -kDirections[d].dr && dc == -kDirections[d].dc) return {d, b};
+        }
+        return {-1, 0};
+    };
+    for (std::size_t j = 0; j < topology.springs.size(); ++j) {
+        const Spring& s = topology.springs[j];
+        const auto [d, start] = s.kind == SpringKind::Structural ? place(s.a, s.b, 0, 1)
+                                : s.kind == SpringKind::Shear    ? place(s.a, s.b, 2, 3)
+                                                                 : place(s.a, s.b, 4, 5);
+        if (d < 0 || (d >= 4 && grid.bends_) || grid.source_[d][start] >= 0) return std::nullopt;
+        grid.source_[d][start] = static_cast<int>(j);
+    }
+    for (std::size_t j = 0; j < topology.bends.size(); ++j) {
+        const Bend& b = topology.bends[j];
+        const auto [d, start] = place(b.a, b.m, 0, 1);
+        const auto [d2, start2] = place(b.m, b.b, 0, 1);
+        if (d < 0 || d2 != d || (start == b.a) != (start2 == b.m)) return std::nullopt;  // not three in a line
+        const std::uint32_t first = start == b.a ? b.a : b.b;
+        if (grid.source_[4 + d][first] >= 0) return std::nullopt;
+        grid.source_[4 + d][first] = static_cast<int>(j);
+    }
+    for (int d = 0; d < 6; ++d) {
+        grid.k_[d].assign(n, 0.0f);
+        grid.rest_[d].assign(n, 0.0f);
+        grid.alpha_[d].assign(n, kInfinite);
+        grid.lambda_[d].assign(n, 0.0);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int j = grid.source_[d][i];
+            if (j >= 0 && !(d >= 4 && grid.bends_)) grid.rest_[d][i] = topology.springs[j].rest_length;
+        }
+    }
+    for (DVec3Array& l : grid.bend_lambda_) l.resize(n);
+    grid.row_corrections_.assign(9 * static_cast<std::size_t>(cols), 0.0);
+    grid.columns_.resize(cols);
+    for (int c = 0; c < cols; ++c) grid.columns_[c] = c;
+    return grid;
+}
+
+void GridXpbd::set_stiffness(const Topology& topology, const SpringSettings& springs) {
+    for (int d = 0; d < 6; ++d) {
+        present_[d] = false;
+        for (std::size_t i = 0; i < k_[d].size(); ++i) {
+            const int j = source_[d][i];
+            float k = 0.0f;
+            if (j >= 0) k = d >= 4 && bends_ ? stiffness_of(springs, topology.bends[j]) : stiffness_of(springs, topology.springs[j]);
+            k_[d][i] = k;
+            present_[d] = present_[d] || k > 0.0f;
+        }
+    }
+    alpha_h_ = 0.0;  // alpha_ follows at the next substep
+}
+
+// alpha = 1 / (k w h^2), computed as step_xpbd computes it: 1 / ((k h) h).
+void GridXpbd::set_substep(double h) {
+    if (h == alpha_h_) return;
+    for (int d = 0; d < 6; ++d) {
+        for (std::size_t i = 0; i < k_[d].size(); ++i) {
+            const double k = k_[d][i];
+            alpha_[d][i] = k > 0.0 ? 1.0 / (k * h * h) : kInfinite;
+        }
+    }
+    alpha_h_ = h;
+}
+
+void GridXpbd::step(State& state, const Dynamics& dynamics, double h) {
+    const std::size_t n = state.size();
+    state.substep = h;
+    set_substep(h);
+    dynamics.external(state, wind_);
+    accelerations(state, wind_, dynamics.gravity, dynamics.damping, a_);
+    start_ = state.position;
+    const double h2 = h * h;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state.pinned[i]) continue;
+        state.position.x[i] += state.motion.x[i] + a_.x[i] * h2;
+        state.position.y[i] += state.motion.y[i] + a_.y[i] * h2;
+        state.position.z[i] += state.motion.z[i] + a_.z[i] * h2;
+    }
+    Pass pass{{state.position.x.data(), state.position.y.data(), state.position.z.data(), state.inverse_mass.data()},
+              rows_, cols_, bends_, &present_, &rest_, &alpha_, &lambda_, &bend_lambda_, {}};
+    double* r = row_corrections_.data();
+    const std::size_t c = static_cast<std::size_t>(cols_);
+    pass.row = {r, r + c, r + 2 * c, r + 3 * c, r + 4 * c, r + 5 * c, r + 6 * c, r + 7 * c, r + 8 * c, columns_.data()};
+    double violation2 = 0.0;
+    switch (FastSolver::kernel()) {
+        case FastKernel::Avx512: violation2 = project_avx512(pass); break;
+        case FastKernel::Avx2: violation2 = project_avx2(pass); break;
+        case FastKernel::Generic: violation2 = project_generic(pass); break;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool held = state.pinned[i] != 0;
+        state.motion.x[i] = held ? 0.0 : state.position.x[i] - start_.x[i];
+        state.motion.y[i] = held ? 0.0 : state.position.y[i] - start_.y[i];
+        state.motion.z[i] = held ? 0.0 : state.position.z[i] - start_.z[i];
+    }
+    substep_ = h;
+    initial_violation_ = std::sqrt(violation2);
+}
+
+double GridXpbd::residual(const DVec3Array& position) const {
+    if (substep_ == 0.0) return 0.0;
+    const double h2 = substep_ * substep_;
+    double residual2 = 0.0;
+    const std::size_t n = position.size();
+    for (int d = 0; d < 6; ++d) {
+        if (!present_[d]) continue;
+        const int offset = kDirections[d].dr * cols_ + kDirections[d].dc;
+        const bool bend = d >= 4 && bends_;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!(k_[d][i] > 0.0f)) continue;
+            const double k = k_[d][i];
+            if (bend) {
+                const DVec3Array& l = bend_lambda_[d - 4];
+                const std::size_t m = i + offset / 2, b = i + offset;
+                const glm::dvec3 pm = position.get(m);
+                const glm::dvec3 c = (position.get(i) - pm) + (position.get(b) - pm);
+                const glm::dvec3 r = c + l.get(i) / (k * h2);
+                residual2 += glm::dot(r, r);
+            } else {
+                const double c = glm::length(position.get(i + offset) - position.get(i)) - rest_[d][i];
+                const double r = c + lambda_[d][i] / (k * h2);
+                residual2 += r * r;
+            }
+        }
+    }
+    return initial_violation_ > 0.0 ? std::sqrt(residual2) / initial_violation_ : 0.0;
+}
+
+}  // namespace clothsim

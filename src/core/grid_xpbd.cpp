@@ -4,6 +4,8 @@
 #include "forces.hpp"
 
 #include <algorithm>
+#include <omp.h>
+
 #include <cmath>
 #include <limits>
 
@@ -197,12 +199,10 @@ template <int Span>
     return violation2;
 }
 
-// What one projection pass needs.
+// What one projection pass needs; `row` is the calling thread's scratch.
 struct Pass {
     Particles p;
     int rows, cols;
-    bool bends;
-    const std::array<bool, 6>* present;
     const std::array<std::vector<float>, 6>* rest;
     const std::array<std::vector<double>, 6>* alpha;
     std::array<std::vector<double>, 6>* lambda;
@@ -210,70 +210,75 @@ struct Pass {
     RowCorrections row;
 };
 
-// Every element once, in the order of the header; returns the sum of C^2.
-[[gnu::always_inline]] inline double project_all(const Pass& pass) {
-    const int rows = pass.rows, cols = pass.cols;
+// The stages of a pass, in order (the header's): the elements of one direction. Along a row (Along*) each
+// row's elements touch that row only; down (Down*) a row's elements touch it and the `span` rows below.
+enum class Stage { AlongSprings, Down, DownRight, DownLeft, AlongSkipOne, DownSkipOne, AlongBends, DownBends };
+
+// Stage `stage`'s batches of rows [first_row, last_row) in row order; returns the sum of C^2.
+[[gnu::always_inline]] inline double project_rows(const Pass& pass, Stage stage, int first_row, int last_row) {
+    const int cols = pass.cols;
     double violation2 = 0.0;
-    auto springs = [&](int d, int first, int last) {
-        violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
-                                              (*pass.lambda)[d].data(), first, last,
-                                              kDirections[d].dr * cols + kDirections[d].dc);
+    auto down = [&](int d, int first_col, int last_col) {
+        for (int r = first_row; r < last_row; ++r) {
+            violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                          (*pass.lambda)[d].data(), r * cols + first_col, r * cols + last_col,
+                                          kDirections[d].dr * cols + kDirections[d].dc);
+        }
     };
-    const std::array<bool, 6>& present = *pass.present;
-    if (present[0]) {
-        for (int r = 0; r < rows; ++r) {
-            for (int phase = 0; phase < 2; ++phase) {
-                violation2 += project_row_springs<1>(pass.p, (*pass.rest)[0].data(), (*pass.alpha)[0].data(),
-                                                     (*pass.lambda)[0].data(), r * cols, cols, phase, pass.row);
+    switch (stage) {
+        case Stage::AlongSprings:
+            for (int r = first_row; r < last_row; ++r) {
+                for (int phase = 0; phase < 2; ++phase) {
+                    violation2 += project_row_springs<1>(pass.p, (*pass.rest)[0].data(), (*pass.alpha)[0].data(),
+                                                         (*pass.lambda)[0].data(), r * cols, cols, phase, pass.row);
+                }
             }
-        }
-    }
-    for (int d = 1; d <= 3; ++d) {
-        if (!present[d]) continue;
-        for (int r = 0; r + 1 < rows; ++r) {
-            const int row = r * cols;
-            springs(d, row + (d == 3 ? 1 : 0), row + cols - (d == 2 ? 1 : 0));
-        }
-    }
-    if (!pass.bends && present[4]) {
-        for (int r = 0; r < rows; ++r) {
-            for (int phase = 0; phase < 3; ++phase) {
-                violation2 += project_row_springs<2>(pass.p, (*pass.rest)[4].data(), (*pass.alpha)[4].data(),
-                                                     (*pass.lambda)[4].data(), r * cols, cols, phase, pass.row);
+            break;
+        case Stage::Down: down(1, 0, cols); break;
+        case Stage::DownRight: down(2, 0, cols - 1); break;
+        case Stage::DownLeft: down(3, 1, cols); break;
+        case Stage::AlongSkipOne:
+            for (int r = first_row; r < last_row; ++r) {
+                for (int phase = 0; phase < 3; ++phase) {
+                    violation2 += project_row_springs<2>(pass.p, (*pass.rest)[4].data(), (*pass.alpha)[4].data(),
+                                                         (*pass.lambda)[4].data(), r * cols, cols, phase, pass.row);
+                }
             }
-        }
-    }
-    if (!pass.bends && present[5]) {
-        for (int r = 0; r + 2 < rows; ++r) springs(5, r * cols, r * cols + cols);
-    }
-    if (!pass.bends) return violation2;
-    auto bends = [&](int k, int first, int last) {
-        DVec3Array& l = (*pass.bend_lambda)[k];
-        violation2 += project_bends(pass.p, (*pass.alpha)[4 + k].data(), l.x.data(), l.y.data(),
-                                            l.z.data(), first, last, k == 0 ? 1 : cols);
-    };
-    if (present[4]) {
-        DVec3Array& l = (*pass.bend_lambda)[0];
-        for (int r = 0; r < rows; ++r) {
-            for (int phase = 0; phase < 3; ++phase) {
-                violation2 += project_row_bends(pass.p, (*pass.alpha)[4].data(), l.x.data(), l.y.data(), l.z.data(),
-                                                r * cols, cols, phase, pass.row);
+            break;
+        case Stage::DownSkipOne: down(5, 0, cols); break;
+        case Stage::AlongBends: {
+            DVec3Array& l = (*pass.bend_lambda)[0];
+            for (int r = first_row; r < last_row; ++r) {
+                for (int phase = 0; phase < 3; ++phase) {
+                    violation2 += project_row_bends(pass.p, (*pass.alpha)[4].data(), l.x.data(), l.y.data(),
+                                                    l.z.data(), r * cols, cols, phase, pass.row);
+                }
             }
-        }
-    }
-    if (present[5]) {
-        for (int r = 0; r + 2 < rows; ++r) bends(1, r * cols, r * cols + cols);
+        } break;
+        case Stage::DownBends: {
+            DVec3Array& l = (*pass.bend_lambda)[1];
+            for (int r = first_row; r < last_row; ++r) {
+                violation2 += project_bends(pass.p, (*pass.alpha)[5].data(), l.x.data(), l.y.data(), l.z.data(),
+                                            r * cols, r * cols + cols, cols);
+            }
+        } break;
     }
     return violation2;
 }
 
-// The kernels: one pass compiled for each instruction set, chosen as the fast solver chooses its own. The
+// The kernels: the stage compiled for each instruction set, chosen as the fast solver chooses its own. The
 // core compiles without contraction into fused multiply-adds, so all three round alike.
-double project_generic(const Pass& pass) { return project_all(pass); }
-__attribute__((target("avx2,fma"))) double project_avx2(const Pass& pass) { return project_all(pass); }
-__attribute__((target("avx512f,avx512vl,avx2,fma"))) double project_avx512(const Pass& pass) {
-    return project_all(pass);
+double project_generic(const Pass& pass, Stage stage, int first, int last) {
+    return project_rows(pass, stage, first, last);
 }
+__attribute__((target("avx2,fma"))) double project_avx2(const Pass& pass, Stage stage, int first, int last) {
+    return project_rows(pass, stage, first, last);
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) double project_avx512(const Pass& pass, Stage stage, int first,
+                                                                           int last) {
+    return project_rows(pass, stage, first, last);
+}
+using Kernel = double (*)(const Pass&, Stage, int, int);
 
 }  // namespace
 
@@ -355,36 +360,97 @@ void GridXpbd::set_substep(double h) {
     alpha_h_ = h;
 }
 
-void GridXpbd::step(State& state, const Dynamics& dynamics, double h) {
+int GridXpbd::effective_threads(int requested) const {
+    const int blocks = (rows_ + kBlockRows - 1) / kBlockRows;
+    const int wanted = requested > 0 ? requested : omp_get_num_procs();
+    return std::max(1, std::min(wanted, blocks));
+}
+
+void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int threads) {
     const std::size_t n = state.size();
     state.substep = h;
     set_substep(h);
     dynamics.external(state, wind_);
-    accelerations(state, wind_, dynamics.gravity, dynamics.damping, a_);
-    start_ = state.position;
-    const double h2 = h * h;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (state.pinned[i]) continue;
-        state.position.x[i] += state.motion.x[i] + a_.x[i] * h2;
-        state.position.y[i] += state.motion.y[i] + a_.y[i] * h2;
-        state.position.z[i] += state.motion.z[i] + a_.z[i] * h2;
-    }
-    Pass pass{{state.position.x.data(), state.position.y.data(), state.position.z.data(), state.inverse_mass.data()},
-              rows_, cols_, bends_, &present_, &rest_, &alpha_, &lambda_, &bend_lambda_, {}};
-    double* r = row_corrections_.data();
-    const std::size_t c = static_cast<std::size_t>(cols_);
-    pass.row = {r, r + c, r + 2 * c, r + 3 * c, r + 4 * c, r + 5 * c, r + 6 * c, r + 7 * c, r + 8 * c, columns_.data()};
+    start_.x.resize(n), start_.y.resize(n), start_.z.resize(n);
+    const int team = effective_threads(threads);
+    const std::size_t scratch = 9 * static_cast<std::size_t>(cols_);
+    if (row_corrections_.size() < team * scratch) row_corrections_.assign(team * scratch, 0.0);
+    // The stages this cloth has, in order.
+    Stage stages[8];
+    int stage_count = 0;
+    auto add = [&](bool present, Stage stage) {
+        if (present) stages[stage_count++] = stage;
+    };
+    add(present_[0], Stage::AlongSprings);
+    add(present_[1], Stage::Down);
+    add(present_[2], Stage::DownRight);
+    add(present_[3], Stage::DownLeft);
+    add(!bends_ && present_[4], Stage::AlongSkipOne);
+    add(!bends_ && present_[5], Stage::DownSkipOne);
+    add(bends_ && present_[4], Stage::AlongBends);
+    add(bends_ && present_[5], Stage::DownBends);
+    Kernel kernel = project_generic;
+    if (FastSolver::kernel() == FastKernel::Avx2) kernel = project_avx2;
+    if (FastSolver::kernel() == FastKernel::Avx512) kernel = project_avx512;
+    const int rows = rows_, blocks = (rows_ + kBlockRows - 1) / kBlockRows;
+    const double h2 = h * h, inv_h = 1.0 / h, damping = dynamics.damping;
+    const glm::dvec3 g(dynamics.gravity);
     double violation2 = 0.0;
-    switch (FastSolver::kernel()) {
-        case FastKernel::Avx512: violation2 = project_avx512(pass); break;
-        case FastKernel::Avx2: violation2 = project_avx2(pass); break;
-        case FastKernel::Generic: violation2 = project_generic(pass); break;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-        const bool held = state.pinned[i] != 0;
-        state.motion.x[i] = held ? 0.0 : state.position.x[i] - start_.x[i];
-        state.motion.y[i] = held ? 0.0 : state.position.y[i] - start_.y[i];
-        state.motion.z[i] = held ? 0.0 : state.position.z[i] - start_.z[i];
+#pragma omp parallel num_threads(team) if (team > 1) reduction(+ : violation2)
+    {
+        double* x = state.position.x.data();
+        double* y = state.position.y.data();
+        double* z = state.position.z.data();
+        double* mx = state.motion.x.data();
+        double* my = state.motion.y.data();
+        double* mz = state.motion.z.data();
+        const float* w = state.inverse_mass.data();
+        const std::uint8_t* pinned = state.pinned.data();
+        // Predict with the external accelerations a = F w + g - c v, v = motion / h, as step_xpbd (accelerations()).
+#pragma omp for schedule(static)
+        for (std::size_t i = 0; i < n; ++i) {
+            start_.x[i] = x[i], start_.y[i] = y[i], start_.z[i] = z[i];
+            if (pinned[i]) continue;
+            const double wi = w[i];
+            const double ax = (static_cast<double>(wind_.x[i]) * wi + g.x) - damping * (mx[i] * inv_h);
+            const double ay = (static_cast<double>(wind_.y[i]) * wi + g.y) - damping * (my[i] * inv_h);
+            const double az = (static_cast<double>(wind_.z[i]) * wi + g.z) - damping * (mz[i] * inv_h);
+            x[i] += mx[i] + ax * h2;
+            y[i] += my[i] + ay * h2;
+            z[i] += mz[i] + az * h2;
+        }
+        Pass pass{{x, y, z, w}, rows_, cols_, &rest_, &alpha_, &lambda_, &bend_lambda_, {}};
+        double* r = row_corrections_.data() + omp_get_thread_num() * scratch;
+        const std::size_t c = static_cast<std::size_t>(cols_);
+        pass.row = {r, r + c, r + 2 * c, r + 3 * c, r + 4 * c, r + 5 * c, r + 6 * c, r + 7 * c, r + 8 * c, columns_.data()};
+        for (int k = 0; k < stage_count; ++k) {
+            const Stage stage = stages[k];
+            if (stage == Stage::AlongSprings || stage == Stage::AlongSkipOne || stage == Stage::AlongBends) {
+#pragma omp for schedule(static)
+                for (int row = 0; row < rows; ++row) violation2 += kernel(pass, stage, row, row + 1);
+                continue;
+            }
+            // Down: each block of rows from its top, all at once; then the rows whose elements reach into the
+            // next block, each block's from its top (the order does not depend on the thread count).
+            const int span = stage == Stage::DownSkipOne || stage == Stage::DownBends ? 2 : 1;
+#pragma omp for schedule(static)
+            for (int b = 0; b < blocks; ++b) {
+                const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
+                violation2 += kernel(pass, stage, first, last - span);  // none reaches past `last`
+            }
+#pragma omp for schedule(static)
+            for (int b = 0; b < blocks; ++b) {
+                const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
+                violation2 += kernel(pass, stage, std::max(first, last - span), std::min(last, rows - span));
+            }
+        }
+#pragma omp for schedule(static)
+        for (std::size_t i = 0; i < n; ++i) {
+            const bool held = pinned[i] != 0;
+            mx[i] = held ? 0.0 : x[i] - start_.x[i];
+            my[i] = held ? 0.0 : y[i] - start_.y[i];
+            mz[i] = held ? 0.0 : z[i] - start_.z[i];
+        }
     }
     substep_ = h;
     initial_violation_ = std::sqrt(violation2);

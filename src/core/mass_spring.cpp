@@ -106,7 +106,10 @@ MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
 const char* MassSpring::fast_kernel_name() { return FastSolver::kernel_name(); }
 
 int MassSpring::solver_threads() const {
-    if (plan_.path != StepPath::Fast) return 1;
+    if (plan_.path != StepPath::Fast) {
+        const bool grid = last_step_fast() && iterative_.data->grid_xpbd;
+        return grid ? iterative_.data->grid_xpbd->effective_threads(settings_.solver.threads) : 1;
+    }
     const bool set_aside = settings_.solver.threads == 0 && fast_.solver->team_set_aside();
     return set_aside ? 1 : fast_.solver->effective_threads(settings_.solver.threads);
 }
@@ -424,7 +427,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
             }
             data.grid_xpbd_ran = settings_.solver.method == SolverMethod::Fast && data.grid_xpbd.has_value();
             if (data.grid_xpbd_ran) {
-                data.grid_xpbd->step(state_, dynamics, h);
+                data.grid_xpbd->step(state_, dynamics, h, settings_.solver.threads);
             } else {
                 step_xpbd(state_, dynamics, topology_, settings_.springs, h, data.xpbd);
             }

@@ -1,5 +1,7 @@
 #include "clothsim/stepper.hpp"
 
+#include <algorithm>
+
 namespace clothsim {
 
 const StabilityLimit& Stepper::limit(const MassSpring& sim) {
@@ -12,7 +14,17 @@ const StabilityLimit& Stepper::limit(const MassSpring& sim) {
 
 int Stepper::choose_substeps(MassSpring& sim) {
     if (policy_.auto_substeps) {
-        sim.set_substeps(auto_substeps(limit(sim), sim.settings().integration.dt, policy_.safety));
+        const IntegrationSettings& integration = sim.settings().integration;
+        int wanted = auto_substeps(limit(sim), integration.dt, policy_.safety);
+        // Implicit Euler, projective and XPBD are stable at large steps (their limit is contact's or damping's
+        // at most): their substeps are a choice of accuracy, which auto substeps raises to the limit but never
+        // lowers (XPBD at 1 substep is stable and far softer than its springs).
+        const Integrator integrator = integration.integrator;
+        if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
+            integrator == Integrator::Xpbd) {
+            wanted = std::max(wanted, integration.substeps);
+        }
+        sim.set_substeps(wanted);
     }
     return sim.settings().integration.substeps;
 }

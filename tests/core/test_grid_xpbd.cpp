@@ -2,6 +2,7 @@
 // the grid's order), across kernels; and the physics it must keep: momentum, pins, convergence to the spring
 // model as the substeps grow.
 #include "fast_solver.hpp"
+#include "grid_xpbd.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
@@ -17,19 +18,23 @@ using namespace clothsim;
 
 namespace {
 
-// The grid form's projection order (grid_xpbd.hpp) as a sort key of an element from start particle `a` to
-// `b`: its direction, then its row, then its phase along the row, then its column.
-std::tuple<int, int, int, int> spring_key(const Topology& t, std::uint32_t a, std::uint32_t b) {
+// The grid form's projection order (grid_xpbd.hpp) as a sort key of an element from particle a to b: its
+// direction; for the directions down, whether it reaches from its block of rows into the next, and its block;
+// then its row, its phase along the row, its column.
+std::tuple<int, int, int, int, int, int> spring_key(const Topology& t, std::uint32_t a, std::uint32_t b) {
     int ra = static_cast<int>(a) / t.cols, ca = static_cast<int>(a) % t.cols;
     int rb = static_cast<int>(b) / t.cols, cb = static_cast<int>(b) % t.cols;
     if (rb < ra || (rb == ra && cb < ca)) std::swap(ra, rb), std::swap(ca, cb);
     const int dr = rb - ra, dc = cb - ca;
-    if (dr == 0 && dc == 1) return {0, ra, ca % 2, ca};  // along the row, every second column
-    if (dr == 1 && dc == 0) return {1, ra, 0, ca};       // down
-    if (dr == 1 && dc == 1) return {2, ra, 0, ca};       // diagonal down right
-    if (dr == 1 && dc == -1) return {3, ra, 0, ca};      // diagonal down left
-    if (dr == 0 && dc == 2) return {4, ra, ca % 3, ca};  // two apart along the row, every third column
-    return {5, ra, 0, ca};                               // two apart down
+    constexpr int block_rows = GridXpbd::kBlockRows;
+    const int block = ra / block_rows;
+    const int reaches = rb >= (block + 1) * block_rows ? 1 : 0;  // into the next block
+    if (dr == 0 && dc == 1) return {0, 0, block, ra, ca % 2, ca};  // along the row, every second column
+    if (dr == 1 && dc == 0) return {1, reaches, block, ra, 0, ca};  // down
+    if (dr == 1 && dc == 1) return {2, reaches, block, ra, 0, ca};  // diagonal down right
+    if (dr == 1 && dc == -1) return {3, reaches, block, ra, 0, ca}; // diagonal down left
+    if (dr == 0 && dc == 2) return {4, 0, block, ra, ca % 3, ca};  // two apart along the row, every third column
+    return {5, reaches, block, ra, 0, ca};                          // two apart down
 }
 
 // `sim`'s topology with its springs and bends listed in the grid form's order.
@@ -74,7 +79,7 @@ double centroid_distance(const State& s, glm::dvec3 reference) {
 }  // namespace
 
 TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's order, bit for bit, with every "
-          "kernel", "[xpbd][grid]") {
+          "kernel and thread count", "[xpbd][grid]") {
     // Skip-one springs (per spring), bends with half-weight edges and warp and weft (material), a disc's absent
     // slots; pins, gravity, damping, wind, a collider. Neither side a multiple of a vector's width.
     Scene material = load_scene("hanging");
@@ -90,6 +95,11 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         {"per-spring drape-sphere", xpbd_scene(per_spring_scene("drape-sphere"), 10, 17, 4)},
         {"material hanging", xpbd_scene(material, 12, 19, 8)},
         {"material disc", xpbd_scene(disc, 15, 15, 8)},
+        // Three blocks of rows and a part of one: the rows that reach into the next block come last.
+        {"per-spring hanging, tall", xpbd_scene(per_spring_scene("hanging"), 2 * GridXpbd::kBlockRows + 9, 9, 8)},
+        {"material hanging, tall", xpbd_scene(material, 3 * GridXpbd::kBlockRows + 1, 10, 8)},
+        // The bundled scene that runs XPBD, on the grid of the simulation loops (support.hpp).
+        {"stiff-drape", test::scene_for_loops("stiff-drape")},
     };
     const FastKernel best = FastSolver::best_kernel();
     for (const auto& [name, scene] : cases) {
@@ -102,10 +112,14 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
             if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
             const FastKernel was = FastSolver::use_kernel(kernel);
-            MassSpring grid = build_simulation(scene);
-            grid.run_steps(40);
-            INFO(name << " with the " << FastSolver::kernel_name() << " kernel");
-            CHECK(same_state(grid, oracle));
+            for (int threads : {1, 2, 3}) {
+                Scene threaded = scene;
+                threaded.settings.solver.threads = threads;
+                MassSpring grid = build_simulation(threaded);
+                grid.run_steps(40);
+                INFO(name << " with the " << FastSolver::kernel_name() << " kernel, " << threads << " threads");
+                CHECK(same_state(grid, oracle));
+            }
             FastSolver::use_kernel(was);
         }
         // And it is another order than the list's: the list-order XPBD differs (the test above means something).

@@ -36,6 +36,11 @@
 // |max - min| over the particles per component, which bounds how much any two particles closed in, off the
 // budget, and tests again only when it is spent (or after kSelfSkipMax substeps). A cloth that falls or
 // rests as a whole spends almost none. The stage then costs one vectorised pass over the motions.
+// A test that finds pairs near each other lists every particle pair within d + kSelfSkin d (a Verlet
+// neighbour list with a skin, as molecular dynamics keeps one): until the particles closed in by the skin,
+// or a fold threshold of the tiles not in the narrow phase is reached, no other pair can come within d, so
+// the substeps between tests only resolve the listed pairs. The pushes themselves move particles outside
+// their motion, so what they moved comes off the budget too.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"
@@ -54,6 +59,7 @@ namespace clothsim {
 inline constexpr int kSelfTile = 4;  // particles along each side of a broad-phase tile
 inline constexpr int kSelfSkipMax = 64;           // substeps one box test that finds nothing covers at most
 inline constexpr double kSelfLookAhead = 8.0;     // far gaps are measured out to d + kSelfLookAhead d
+inline constexpr double kSelfSkin = 0.5;          // a test lists the pairs within d + kSelfSkin d
 
 // The cloth's particle spacing: its longest structural rest length (0 without structural springs).
 double particle_spacing(const Topology& topology);
@@ -84,6 +90,12 @@ public:
     // is not 0.
     SelfCollisionCounts collide(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
                                 const MotionBounds* known = nullptr);
+    // Something moved particles outside a step (an edit, a restart): the next substep tests afresh.
+    void invalidate() { tested_distance_ = 0.0; }
+
+    // The particle pairs (i << 32 | j, i < j) the last substep resolved from: every pair within d + skin at
+    // the last test.
+    const std::vector<std::uint64_t>& listed_pairs() const { return candidates_; }
 
     // Whether particles i and j share a spring or a bend (then they never collide).
     bool neighbours(std::uint32_t i, std::uint32_t j) const;
@@ -118,19 +130,25 @@ private:
     std::vector<glm::vec3> normal_;         // grid: each tile's mean normal
     std::vector<double> area_, diagonals_;  // grid: each tile's |vector area| and |D1| + |D2|
     std::vector<std::uint64_t> tile_pairs_; // (a << 32 | b), a <= b: the tile pairs the narrow phase tests
-    std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within d
+    std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within d + skin at the last test
+    long long listed_tiles_ = 0;            // tiles the last test sent to the narrow phase
+    std::vector<double> pushed_;            // per particle, how far the pushes of this substep moved it (m)
+    std::vector<std::uint32_t> pushed_list_; // the particles pushed this substep
     std::vector<TilePoints> points_;
     std::vector<std::uint8_t> gathered_;
     double budget_ = 0.0;                   // closing left before the next test (conservative advancement)
     int skipped_ = 0;                       // substeps skipped since the last test
-    double tested_distance_ = 0.0;          // the d the last test that found nothing was made for (0: none)
+    double tested_distance_ = 0.0;          // the d the last test was made for (0: none, test at the next substep)
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;
     void tile_boxes(const DVec3Array& position);
-    // Lists the tile pairs the narrow phase tests: far tiles within d of each other, and each folded tile
-    // with itself and its neighbours. Returns how many tiles it marked; when none, `budget` is the closing
-    // the next substeps may spend before a test is needed again.
-    std::size_t mark_active(const DVec3Array& position, float d, float reach, double& budget);
+    // Lists the tile pairs the narrow phase tests: far tiles within d + skin of each other, and each folded
+    // tile with itself and its neighbours. Returns how many tiles it marked, and in `budget` the closing the
+    // next substeps may spend before a test is needed again (the skin at most when it marked some).
+    std::size_t mark_active(const DVec3Array& position, float d, float skin, float reach, double& budget);
+    // Pushes apart the listed pairs that are closer than min(d, rest distance); the pushes come off the budget.
+    void resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position, double d,
+                 SelfCollisionCounts& counts);
     void gather(std::uint32_t t, const State& state, TilePoints& out) const;
 };
 

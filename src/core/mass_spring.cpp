@@ -156,6 +156,8 @@ void MassSpring::step() {
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
     const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
+    // Self-collision's list of near pairs holds while only steps move the particles (self_collision.hpp).
+    if (!continues && self_collision_) self_collision_->invalidate();
 
     switch (plan_.path) {
         case StepPath::Fast: step_fast(h, profile); break;

@@ -101,6 +101,8 @@ SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_po
 }
 
 void SelfCollision::update_neighbours(const Topology& topology) {
+    tested_distance_ = 0.0;  // pairs that shared a spring may meet now: test at the next substep
+    candidates_.clear();
     // Compressed rows: count, fill, then sort and drop repeats within each particle's run.
     std::vector<std::uint32_t> begin(particles_ + 1, 0);
     auto each_link = [&](auto&& link) {
@@ -181,11 +183,14 @@ void SelfCollision::tile_boxes(const DVec3Array& position) {
     }
 }
 
-// The box test, the fold test and the narrow phase's tile pairs (see the header). When it marks nothing it
-// sets `budget`: how far any two particles may close in before the next test is needed (0: test again at
-// the next substep).
-std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, float reach, double& budget) {
+// The box test, the fold test and the narrow phase's tile pairs (see the header), and `budget`: how far any
+// two particles may close in before the next test is needed (0: test again at the next substep).
+std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, float skin, float reach, double& budget) {
     constexpr float kCrumpled = 0.8f;  // box diagonal over rest diagonal below which a region counts as folded
+    // Neighbours whose mean normals are more than 60 degrees apart go to the narrow phase. Only a hairpin
+    // (more than 90) can meet itself, but a pair bent near 90 degrees (over a cube's edge) would leave the
+    // others almost no budget (the cosine's distance to 0, below).
+    constexpr float kBent = 0.5f;
     const std::size_t tiles = boxes_.size();
     // Insertion sort by lo.x from the last substep's order: nearly sorted already, so nearly linear.
     for (std::size_t k = 1; k < tiles; ++k) {
@@ -210,8 +215,8 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
             }
         }
     };
-    // Far pairs within d of each other.
-    far_pairs(d, [&](std::uint32_t a, std::uint32_t b) {
+    // Far pairs within d + skin of each other.
+    far_pairs(d + skin, [&](std::uint32_t a, std::uint32_t b) {
         active_[a] = active_[b] = 1;
         tile_pairs_.push_back(pair_key(a, b));
     });
@@ -249,34 +254,39 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
             for (int k = 1; k < 5; ++k) {
                 if (rest[k] == 0.0f) continue;
                 const std::uint32_t u = neighbour(t, k);
-                if (!(glm::dot(normal_[t], normal_[u]) >= 0.0f)) active_[t] = active_[u] = 2;
+                if (!(glm::dot(normal_[t], normal_[u]) >= kBent)) active_[t] = active_[u] = 2;
                 if (boxes_[t].empty() || boxes_[u].empty()) continue;
                 if (box_diagonal(joined(boxes_[t], boxes_[u])) < kCrumpled * rest[k]) active_[t] = active_[u] = 2;
             }
         }
     }
     const bool any_active = std::find_if(active_.begin(), active_.end(), [](std::uint8_t a) { return a != 0; }) != active_.end();
-    if (!any_active) {
-        // The budget: how much any two particles may close in before a test could find something. When no
-        // two particles close in by more than b, far boxes come b nearer at most, a diagonal shrinks by at
-        // most b, a vector area (the cross product of the diagonals D1, D2) by at most b (|D1| + |D2|), and
-        // a mean normal turns by at most 2 b (|D1| + |D2|) / |area| radians (to first order); two normals
-        // with cosine c are at least asin(c) >= c radians from being 90 degrees apart.
-        budget = reach - d;
-        for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
+    // The budget: how much any two particles may close in before a test could find something new. When no
+    // two particles close in by more than b, far boxes come b nearer at most, a diagonal shrinks by at most
+    // b, a vector area (the cross product of the diagonals D1, D2) by at most b (|D1| + |D2|), and a mean
+    // normal turns by at most 2 b (|D1| + |D2|) / |area| radians (to first order); two normals with cosine c
+    // are at least asin(c) >= c radians from being 90 degrees apart. With tiles in the narrow phase, their
+    // pairs are listed out to d + skin, so the skin bounds it, and the fold thresholds of the tiles and
+    // neighbour pairs not in the narrow phase yet.
+    budget = any_active ? skin : reach - d;
+    for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
+        const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
+        if (active_[t] != 2) {
             budget = std::min(budget, (area_[t] - 0.5 * rest_area_[t]) / diagonals_[t]);
-            const double turn_t = 2.0 * diagonals_[t] / area_[t];
-            const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
             if (!boxes_[t].empty()) budget = std::min(budget, static_cast<double>(box_diagonal(boxes_[t]) - kCrumpled * rest[0]));
-            for (int k = 1; k < 5; ++k) {
-                if (rest[k] == 0.0f) continue;
-                const std::uint32_t u = neighbour(t, k);
-                const double cosine = glm::dot(normal_[t], normal_[u]);
-                budget = std::min(budget, cosine / (turn_t + 2.0 * diagonals_[u] / area_[u]));
-                if (boxes_[t].empty() || boxes_[u].empty()) continue;
-                budget = std::min(budget, static_cast<double>(box_diagonal(joined(boxes_[t], boxes_[u])) - kCrumpled * rest[k]));
-            }
         }
+        const double turn_t = 2.0 * diagonals_[t] / area_[t];
+        for (int k = 1; k < 5; ++k) {
+            if (rest[k] == 0.0f) continue;
+            const std::uint32_t u = neighbour(t, k);
+            if (active_[t] == 2 || active_[u] == 2) continue;  // their pair is in the narrow phase
+            const double cosine = glm::dot(normal_[t], normal_[u]);
+            budget = std::min(budget, cosine / (turn_t + 2.0 * diagonals_[u] / area_[u]));
+            if (boxes_[t].empty() || boxes_[u].empty()) continue;
+            budget = std::min(budget, static_cast<double>(box_diagonal(joined(boxes_[t], boxes_[u])) - kCrumpled * rest[k]));
+        }
+    }
+    if (!any_active) {
         // Far boxes need be looked for only out to d + the budget the folds leave: a nearer gap lowers it.
         if (budget > 0.0) {
             far_pairs(static_cast<float>(d + budget), [&](std::uint32_t a, std::uint32_t b) {
@@ -286,6 +296,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
         if (!(budget > 0.0)) budget = 0.0;  // also NaN
         return 0;
     }
+    if (!(budget > 0.0)) budget = 0.0;
     std::size_t count = 0;
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (active_[t] == 0) continue;
@@ -362,32 +373,35 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
         clamped = true;
     }
 
-    // Conservative advancement: since the last test that found nothing, no two particles closed in by more
-    // than the sum of this spread of motions, and the test left room for `budget_` of it.
+    // Conservative advancement: since the last test, no two particles closed in by more than the sum of
+    // these spreads of motions (and of the pushes below), and the test left room for `budget_` of it. Until
+    // it is spent, the particle pairs it listed (all within d + skin then) are the only ones that can touch.
+    const double skin = kSelfSkin * d;
     if (tested_distance_ == d && !clamped && skipped_ < kSelfSkipMax) {
         budget_ -= range.spread();
         if (budget_ > 0.0) {
             ++skipped_;
+            counts.tiles_active = listed_tiles_;
+            resolve(state, settings, rest_position, d, counts);
             return counts;
         }
     }
     tile_boxes(state.position);
     counts.tiles = static_cast<long long>(boxes_.size());
     double budget = 0.0;
-    const std::size_t marked = mark_active(state.position, static_cast<float>(d), static_cast<float>((1.0 + kSelfLookAhead) * d), budget);
-    tested_distance_ = 0.0;
-    if (marked == 0) {
-        budget_ = budget;
-        skipped_ = 0;
-        tested_distance_ = d;
-        return counts;
-    }
-    if (tile_pairs_.empty()) return counts;
-
-    // Candidate pairs: within d (in float, with a margin the double test below decides) from each tile pair
-    // once, so each particle pair at most once; resolved in (i, j) order whatever order the tiles came in.
-    const float reach2 = static_cast<float>(1.001 * d * d);
+    const std::size_t marked = mark_active(state.position, static_cast<float>(d), static_cast<float>(skin),
+                                           static_cast<float>((1.0 + kSelfLookAhead) * d), budget);
+    budget_ = budget;
+    skipped_ = 0;
+    tested_distance_ = d;
     candidates_.clear();
+    listed_tiles_ = 0;
+    if (marked == 0 || tile_pairs_.empty()) return counts;
+
+    // Candidate pairs: within d + skin (in float, with a margin; the double test in resolve decides) from each
+    // tile pair once, so each particle pair at most once; resolved in (i, j) order whatever order the tiles
+    // came in.
+    const float reach2 = static_cast<float>(1.001 * (d + skin) * (d + skin));
     points_.resize(boxes_.size());
     gathered_.assign(boxes_.size(), 0);
     for (const std::uint64_t key : tile_pairs_) {
@@ -421,8 +435,23 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
         }
     }
     std::sort(candidates_.begin(), candidates_.end());
-    counts.tiles_active = static_cast<long long>(std::count(gathered_.begin(), gathered_.end(), std::uint8_t{1}));
+    listed_tiles_ = static_cast<long long>(std::count(gathered_.begin(), gathered_.end(), std::uint8_t{1}));
+    counts.tiles_active = listed_tiles_;
+    resolve(state, settings, rest_position, d, counts);
+    return counts;
+}
 
+// The listed pairs closer than min(d, their rest distance), pushed apart in (i, j) order. The pushes move
+// particles outside their motion: any two particles may close in by the sum of the distances each was
+// pushed, which comes off the budget (twice the largest).
+void SelfCollision::resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
+                            double d, SelfCollisionCounts& counts) {
+    pushed_.resize(particles_, 0.0);
+    pushed_list_.clear();
+    auto moved = [&](std::uint32_t p, double distance) {
+        if (pushed_[p] == 0.0) pushed_list_.push_back(p);
+        pushed_[p] += distance;
+    };
     for (const std::uint64_t key : candidates_) {
         const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
         const double wi = state.inverse_mass[i], wj = state.inverse_mass[j], w = wi + wj;
@@ -438,6 +467,8 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
         const double push = least - length;
         state.position.add(i, -(wi / w) * push * normal);
         state.position.add(j, (wj / w) * push * normal);
+        moved(i, (wi / w) * push);
+        moved(j, (wj / w) * push);
         // Inelastic: the approach along the normal goes; friction slows the sliding by at most mu x push
         // (the push is the contact's normal displacement this substep).
         glm::dvec3 relative = state.motion.get(j) - state.motion.get(i);
@@ -453,7 +484,12 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
         state.motion.add(j, -(wj / w) * change);
         ++counts.contacts;
     }
-    return counts;
+    double largest = 0.0;
+    for (const std::uint32_t p : pushed_list_) {
+        largest = std::max(largest, pushed_[p]);
+        pushed_[p] = 0.0;
+    }
+    budget_ -= 2.0 * largest;
 }
 
 }  // namespace clothsim

@@ -181,6 +181,62 @@ TEST_CASE("self-collision: two approaching strangers are pushed to the distance,
     CHECK(glm::length(sim.momentum() - before) < 1e-6f);
 }
 
+TEST_CASE("self-collision: between tests the stage resolves every touching pair a test would find, at every "
+          "substep of pile and fold", "[self-collision]") {
+    // The stage tests the tiles only when the closing since its last test may have spent the skin of its list
+    // (or a fold threshold): at every substep, every pair of strangers closer than min(d, rest distance) that a
+    // test made there would find must be in the list it resolves. A stage of its own follows the simulation's
+    // states substep by substep and is checked against a new stage, which tests at its first substep. The
+    // simulation runs without self-collision, so that the particles move between two substeps by their
+    // motion only (the stage's own pushes, which it counts, stay on its copy); its layers then meet and pass
+    // through each other, which the list must follow all the same.
+    for (const char* name : {"pile", "fold"}) {
+        Scene scene = load_scene(name);
+        scene.settings.collision.self = false;
+        MassSpring sim = build_simulation(scene);
+        const DVec3Array rest = sim.state().position;  // built flat, at rest
+        SelfCollision stage(sim.topology(), rest);
+        const CollisionSettings& settings = sim.settings().collision;
+        const double d = stage.contact_distance(settings);
+        long long checked = 0, from_list = 0, touching = 0;
+        const long long substeps = 90LL * sim.settings().integration.substeps / test::kLoopShare;
+        for (long long k = 0; k < substeps; ++k) {
+            sim.step();
+            const State before = sim.state();
+            State state = before;
+            const SelfCollisionCounts counts = stage.collide(state, settings, rest);
+            if (counts.clamped > 0) continue;  // the clamp moved particles before the list was made
+            ++checked;
+            if (counts.tiles > 0) continue;  // it tested too
+            ++from_list;
+            // What a test made now finds: a new stage's list, the pairs in it that touch.
+            SelfCollision fresh(sim.topology(), rest);
+            State tested = before;
+            fresh.collide(tested, settings, rest);
+            std::vector<std::uint64_t> touch;
+            for (const std::uint64_t key : fresh.listed_pairs()) {
+                const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
+                const double least = std::min(d, glm::length(rest.get(j) - rest.get(i)));
+                if (glm::length(before.position.get(j) - before.position.get(i)) < least) touch.push_back(key);
+            }
+            touching += static_cast<long long>(touch.size());
+            const std::vector<std::uint64_t>& listed = stage.listed_pairs();
+            long long missing = 0;
+            for (const std::uint64_t key : touch) missing += std::binary_search(listed.begin(), listed.end(), key) ? 0 : 1;
+            if (missing > 0) {
+                INFO(name << ": substep " << k << ", " << missing << " of " << touch.size() << " touching pairs not listed");
+                CHECK(missing == 0);
+                break;
+            }
+        }
+        INFO(name << ": " << checked << " substeps checked, " << from_list << " resolved from an earlier test's list, "
+                  << touching << " touching pairs there");
+        CHECK(checked > substeps / 2);
+        CHECK(from_list > checked / 10);  // substeps between tests use the list (what the test is about)
+        CHECK(touching > 0);             // and the layers meet there
+    }
+}
+
 TEST_CASE("self-collision: a flat cloth costs a box test and steps bit-identically to one without it", "[self-collision]") {
     Scene scene = load_scene("falling");
     scene.settings.collision.self = false;

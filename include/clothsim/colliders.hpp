@@ -22,6 +22,9 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstddef>
+#include <cstdint>
+
 #include <vector>
 
 namespace clothsim {
@@ -53,6 +56,9 @@ struct CollisionBlocks {
     Box cloth;                       // contains every block's box
     bool boxes_current = false;      // the block boxes bound the particles as they are now (the fast solver's)
     bool current = false;            // ... and `cloth` bounds them
+    // Scratch of collide_stage: the blocks a collider tests, and which of them its pushes grew.
+    std::vector<std::uint32_t> tested;
+    std::vector<std::uint8_t> grown;
     std::size_t count() const { return start.empty() ? 0 : start.size() - 1; }
 };
 
@@ -61,9 +67,12 @@ struct CollisionBlocks {
 // particle by particle only on the blocks whose box may touch it (broad_phase.hpp). The boxes are computed
 // here unless the fast solver left them (boxes_current), and a block's box is grown by the farthest push a
 // collider gave one of its particles, so the next collider's test stays conservative.
-// Each collider's time and block counts go to `profile` when it is not null. Returns false when no particle
-// was tested against any collider, so none moved.
+// Each collider's time and block counts go to `profile` when it is not null. `threads` share the blocks a
+// collider tests when they hold kParallelCollisionParticles particles or more (four times as many for the
+// ground; the same result for any count). Returns false when no particle was tested against any collider, so
+// none moved.
+inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile);
+                   StepProfile* profile, int threads = 1);
 
 }  // namespace clothsim

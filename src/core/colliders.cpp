@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <type_traits>
 #include <utility>
 
 namespace clothsim {
@@ -217,14 +218,27 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
 // Returns the number of blocks tested: none, and no particle moved.
 template <class Shape>
 long long collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
-                         int which, StepProfile* profile) {
-    long long tested = 0;
-    // First the whole cloth: a collider out of its reach costs this one test.
+                         int which, int threads, StepProfile* profile) {
+    // First the whole cloth: a collider out of its reach costs this one test; then each block's box.
     const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
+    blocks.tested.clear();
+    std::size_t particles = 0;
     for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
-        const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
-        ++tested;
+        blocks.tested.push_back(static_cast<std::uint32_t>(k));
+        particles += blocks.start[k + 1] - blocks.start[k];
+    }
+    const auto tested = static_cast<long long>(blocks.tested.size());
+    blocks.grown.assign(blocks.tested.size(), 0);
+    // Blocks hold distinct particles: threads share them when there are enough to pay for the fork (four
+    // times as many for the ground, whose test is a comparison), and the result is the same for any count.
+    const std::size_t enough = std::is_same_v<Shape, GroundCollider> ? 4 * kParallelCollisionParticles
+                                                                     : kParallelCollisionParticles;
+    const int team = threads > 1 && particles >= enough ? threads : 1;
+#pragma omp parallel for num_threads(team) if (team > 1) schedule(dynamic, 16)
+    for (long long t = 0; t < tested; ++t) {
+        const std::size_t k = blocks.tested[t];
+        const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         const float moved = static_cast<float>(collide_shape(state, shape, double(shape.friction), double(thickness), begin, end));
         if (moved > 0.0f && broad_phase) {
             // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
@@ -234,9 +248,14 @@ long long collide_blocks(State& state, const Shape& shape, float thickness, bool
             const glm::vec3 grow(moved * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::max({far.x, far.y, far.z})));
             box.lo -= grow;
             box.hi += grow;
-            blocks.cloth.lo = glm::min(blocks.cloth.lo, box.lo);  // grows only: stays conservative
-            blocks.cloth.hi = glm::max(blocks.cloth.hi, box.hi);
+            blocks.grown[t] = 1;
         }
+    }
+    for (long long t = 0; t < tested; ++t) {
+        if (!blocks.grown[t]) continue;
+        const Box& box = blocks.boxes[blocks.tested[t]];
+        blocks.cloth.lo = glm::min(blocks.cloth.lo, box.lo);  // grows only: stays conservative
+        blocks.cloth.hi = glm::max(blocks.cloth.hi, box.hi);
     }
     if (profile) {
         profile->blocks_tested[which] += tested;
@@ -275,7 +294,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile) {
+                   StepProfile* profile, int threads) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
         blocks.start = block_starts(state.size(), 0, 0);
         blocks.current = blocks.boxes_current = false;
@@ -317,19 +336,19 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     long long tested = 0;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), profile);
+        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), threads, profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), profile);
+        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), threads, profile);
     }
     if (colliders.cylinder.enabled) {
         StageTimer timer(profile, Stage::Cylinder);
-        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), profile);
+        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), threads, profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), profile);
+        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), threads, profile);
     }
     return tested > 0;
 }

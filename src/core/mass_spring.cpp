@@ -244,7 +244,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
 
 bool MassSpring::collide(StepProfile* profile) {
     if (!plan_.any_collider()) return false;
-    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile);
+    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads());
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.

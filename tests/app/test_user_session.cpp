@@ -312,7 +312,7 @@ TEST_CASE("user session: Open file... shows the desktop's dialog (zenity) and op
                                                       "\necho " + quote(scene_path("curtain")));
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
                                          "echo \"title before: $(xdotool getwindowname $wid)\"\n"
-                                         "click 50 82\nsettle\n"
+                                         "click 50 82\ntitle_has curtain\n"
                                          "echo \"title after: $(xdotool getwindowname $wid)\"\nquit\n",
                                          env);
     CAPTURE_RUN(r);
@@ -344,7 +344,7 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
 
     // Another run, on flag: the Recent combo (right of Open file...) lists the saved file first.
     const RunResult second = run_user_session(dir, {"--scene", "flag", "--paused"},
-                                              "click 220 82\nclick 220 106\n"
+                                              "click 220 82\nclick 220 106\ntitle_has curtain\n"
                                               "echo \"title: $(xdotool getwindowname $wid)\"\nquit\n");
     CAPTURE_RUN(second);
     REQUIRE(second.code == 0);
@@ -388,6 +388,7 @@ TEST_CASE("user session: a .toml dropped onto the window opens, other dropped fi
                                          "drop 900 400 " + quote(bad.string()) + "\n"
                                          "echo \"title bad: $(xdotool getwindowname $wid)\"\n"
                                          "drop 900 400 " + quote(picture.string()) + " " + quote(curtain.string()) + "\n"
+                                         "title_has curtain\n"
                                          "echo \"title dropped: $(xdotool getwindowname $wid)\"\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);

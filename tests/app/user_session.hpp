@@ -22,6 +22,8 @@ namespace clothsim::test {
 //   cut X0 Y0 X1 Y1      the same with the right button and Shift held (the knife)
 //   shot NAME            an F12 screenshot, saved as NAME (a PNG in the session's directory)
 //   settle               waits for a few frames to be drawn
+//   title_has TEXT       waits (up to 15 s) until the window's title contains TEXT: an action whose effect
+//                        takes longer than a few frames under load (a file opened through the dialog)
 //   drop X Y FILE...     drops files at (X, Y) as a file manager does (XDND, tests/app/xdnd_drop.cpp)
 //   quit                 presses Escape (the app's quit key) with the pointer over the 3D view
 // Each action waits long enough afterwards for the app to have drawn frames with it (also in the ASan build).
@@ -39,6 +41,7 @@ drag() { at "$1" "$2"; xdotool mousedown 1; sleep 0.3; xdotool mousemove --windo
 cut() { at "$1" "$2"; xdotool keydown shift; sleep 0.2; xdotool mousedown 3; sleep 0.3;
         xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5; xdotool mouseup 3; sleep 0.2; xdotool keyup shift; settle; }
 quit() { at 900 400; key Escape; }
+title_has() { for _ in $(seq 150); do xdotool getwindowname "$wid" | grep -qF -- "$1" && break; sleep 0.1; done; }
 drop() { local x="$1" y="$2"; shift 2; "$XDND_DROP" "$wid" "$x" "$y" "$@" || echo "drop: not taken" >&2; settle; }
 shot() {
   rm -f clothsim-*.png
@@ -64,7 +67,10 @@ inline RunResult run_user_session(const TempDir& dir, const std::vector<std::str
     std::ofstream(script) << "set -u\ncd " << quote(dir.path().string()) << "\n"
                           << R"sh(
 XDND_DROP=)sh" << quote(CLOTHSIM_XDND_DROP) << R"sh(
-# A private X server: -displayfd writes its display number once it accepts clients.
+# A private X server: -displayfd writes its display number once it accepts clients. The last session's
+# file goes first: the shell truncates it only when the server's process starts, and a loop that read it
+# before then found the old number's file non-empty and then read it empty (DISPLAY=":").
+rm -f xvfb.display
 Xvfb -displayfd 3 -screen 0 1280x720x24 -nolisten tcp -noreset 3>xvfb.display 2>xvfb.log &
 xvfb=$!
 trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null' EXIT

@@ -380,3 +380,44 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         }
     }
 }
+
+TEST_CASE("broad_phase collide_stage shared by threads moves every particle exactly as testing them all", "[broad_phase]") {
+    ColliderSettings colliders;
+    colliders.sphere = {true, {0.0f, 0.3f, 0.0f}, 0.3f, 0.4f};
+    colliders.cube = {true, {0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}, 0.3f};
+    colliders.cylinder = {true, {-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f, 0.3f};
+    colliders.ground = {true, 0.0f, 0.5f};
+    colliders.thickness = 0.005f;
+    // Enough particles for the stage to share its blocks among threads, in the cloth's order (blocks along x).
+    const std::size_t n = 4 * kParallelCollisionParticles + 333;  // the ground's threshold too
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
+    State start;
+    start.position.resize(n);
+    start.motion.resize(n);
+    start.mass.assign(n, 1.0f);
+    start.inverse_mass.assign(n, 1.0f);
+    start.pinned.assign(n, 0);
+    std::vector<float> xs(n);
+    for (float& v : xs) v = x(rng);
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t i = 0; i < n; ++i) {
+        start.position.set(i, {xs[i], y(rng), z(rng)});
+        start.motion.set(i, {m(rng), m(rng), m(rng)});
+        if (i % 97 == 0) start.pinned[i] = 1;
+    }
+    State all = start;
+    collide_all(all, colliders);
+    for (int threads : {1, 2, 3}) {
+        INFO(threads << " threads");
+        State shared = start;
+        CollisionBlocks blocks;
+        blocks.start = block_starts(n, 0, 0);
+        StepProfile profile;
+        collide_stage(shared, colliders, true, blocks, &profile, threads);
+        CHECK(shared.position == all.position);
+        CHECK(shared.motion == all.motion);
+        for (std::size_t c = 0; c < kColliderCount; ++c) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);
+    }
+    CHECK(!(all.position == start.position));  // something was pushed
+}

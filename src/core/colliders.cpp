@@ -235,8 +235,7 @@ long long collide_blocks(State& state, const Shape& shape, float thickness, bool
     const std::size_t enough = std::is_same_v<Shape, GroundCollider> ? 4 * kParallelCollisionParticles
                                                                      : kParallelCollisionParticles;
     const int team = threads > 1 && particles >= enough ? threads : 1;
-#pragma omp parallel for num_threads(team) if (team > 1) schedule(dynamic, 16)
-    for (long long t = 0; t < tested; ++t) {
+    auto test = [&](long long t) {
         const std::size_t k = blocks.tested[t];
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         const float moved = static_cast<float>(collide_shape(state, shape, double(shape.friction), double(thickness), begin, end));
@@ -250,6 +249,13 @@ long long collide_blocks(State& state, const Shape& shape, float thickness, bool
             box.hi += grow;
             blocks.grown[t] = 1;
         }
+    };
+    // One thread runs no OpenMP construct at all (libgomp would make a team of one for it every time).
+    if (team > 1) {
+#pragma omp parallel for num_threads(team) schedule(dynamic, 16)
+        for (long long t = 0; t < tested; ++t) test(t);
+    } else {
+        for (long long t = 0; t < tested; ++t) test(t);
     }
     for (long long t = 0; t < tested; ++t) {
         if (!blocks.grown[t]) continue;

@@ -225,26 +225,21 @@ enum class Stage { AlongSprings, Down, DownRight, DownLeft, AlongSkipOne, DownSk
                                           kDirections[d].dr * cols + kDirections[d].dc);
         }
     };
-    switch (stage) {
-        case Stage::AlongSprings:
-            for (int r = first_row; r < last_row; ++r) {
-                for (int phase = 0; phase < 2; ++phase) {
-                    violation2 += project_row_springs<1>(pass.p, (*pass.rest)[0].data(), (*pass.alpha)[0].data(),
-                                                         (*pass.lambda)[0].data(), r * cols, cols, phase, pass.row);
-                }
+    // Springs along the rows, two apart when Span is 2: every (Span + 1)th column per pass.
+    auto along = [&]<int Span>(int d) {
+        for (int r = first_row; r < last_row; ++r) {
+            for (int phase = 0; phase <= Span; ++phase) {
+                violation2 += project_row_springs<Span>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                                        (*pass.lambda)[d].data(), r * cols, cols, phase, pass.row);
             }
-            break;
+        }
+    };
+    switch (stage) {
+        case Stage::AlongSprings: along.template operator()<1>(0); break;
         case Stage::Down: down(1, 0, cols); break;
         case Stage::DownRight: down(2, 0, cols - 1); break;
         case Stage::DownLeft: down(3, 1, cols); break;
-        case Stage::AlongSkipOne:
-            for (int r = first_row; r < last_row; ++r) {
-                for (int phase = 0; phase < 3; ++phase) {
-                    violation2 += project_row_springs<2>(pass.p, (*pass.rest)[4].data(), (*pass.alpha)[4].data(),
-                                                         (*pass.lambda)[4].data(), r * cols, cols, phase, pass.row);
-                }
-            }
-            break;
+        case Stage::AlongSkipOne: along.template operator()<2>(4); break;
         case Stage::DownSkipOne: down(5, 0, cols); break;
         case Stage::AlongBends: {
             DVec3Array& l = (*pass.bend_lambda)[0];
@@ -396,8 +391,10 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     const double h2 = h * h, inv_h = 1.0 / h, damping = dynamics.damping;
     const glm::dvec3 g(dynamics.gravity);
     double violation2 = 0.0;
-#pragma omp parallel num_threads(team) if (team > 1) reduction(+ : violation2)
-    {
+    // The whole substep, run by every thread of the team (its loops are shared with `omp for`), or by this
+    // thread alone without any OpenMP construct (libgomp would make a team of one for it every time).
+    auto substep = [&]() {
+        double violation = 0.0;
         double* x = state.position.x.data();
         double* y = state.position.y.data();
         double* z = state.position.z.data();
@@ -427,7 +424,7 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
             const Stage stage = stages[k];
             if (stage == Stage::AlongSprings || stage == Stage::AlongSkipOne || stage == Stage::AlongBends) {
 #pragma omp for schedule(static)
-                for (int row = 0; row < rows; ++row) violation2 += kernel(pass, stage, row, row + 1);
+                for (int row = 0; row < rows; ++row) violation += kernel(pass, stage, row, row + 1);
                 continue;
             }
             // Down: each block of rows from its top, all at once; then the rows whose elements reach into the
@@ -436,12 +433,12 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
 #pragma omp for schedule(static)
             for (int b = 0; b < blocks; ++b) {
                 const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
-                violation2 += kernel(pass, stage, first, last - span);  // none reaches past `last`
+                violation += kernel(pass, stage, first, last - span);  // none reaches past `last`
             }
 #pragma omp for schedule(static)
             for (int b = 0; b < blocks; ++b) {
                 const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
-                violation2 += kernel(pass, stage, std::max(first, last - span), std::min(last, rows - span));
+                violation += kernel(pass, stage, std::max(first, last - span), std::min(last, rows - span));
             }
         }
 #pragma omp for schedule(static)
@@ -451,6 +448,13 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
             my[i] = held ? 0.0 : y[i] - start_.y[i];
             mz[i] = held ? 0.0 : z[i] - start_.z[i];
         }
+        return violation;
+    };
+    if (team > 1) {
+#pragma omp parallel num_threads(team) reduction(+ : violation2)
+        violation2 += substep();
+    } else {
+        violation2 = substep();
     }
     substep_ = h;
     initial_violation_ = std::sqrt(violation2);

@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     CLI::App app{"clothsim-bench: solver throughput and frame budget"};
     std::vector<int> sizes{32, 64, 128, 256, 512};
     std::vector<int> thread_counts{1, 2};
-    std::string scene = "hanging", csv_path, json_path;
+    std::string scene = "hanging", csv_path, json_path, kernel_name;
     int repeats = 7;
     double min_seconds = 0.05;
     double budget_ms = 8.0;
@@ -117,6 +117,8 @@ int main(int argc, char** argv) {
     app.add_option("--budget-ms", budget_ms, "Frame budget for the substeps-per-frame figure")->capture_default_str();
     app.add_option("--csv", csv_path, "Write the table as CSV");
     app.add_option("--json", json_path, "Write the table and the frame budget as JSON");
+    app.add_option("--kernel", kernel_name,
+                   "The fast solver's kernel: avx512, avx2 or generic (default: the best this CPU runs)");
     bench::WorkPrecisionOptions wp;
     CLI::App* work_precision =
         app.add_subcommand("work-precision", "Run time against error for every integrator (docs/ACCURACY.md)");
@@ -181,6 +183,11 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
+    }
+    if (!kernel_name.empty() && !MassSpring::use_fast_kernel(kernel_name)) {
+        std::fprintf(stderr, "clothsim-bench: --kernel %s: not a kernel this CPU runs (best here: %s)\n",
+                     kernel_name.c_str(), MassSpring::fast_kernel_name());
+        return 2;
     }
     if (*work_precision) return bench::run_work_precision(wp);
     if (*stiff_precision) return bench::run_stiff_precision(sp);

@@ -37,6 +37,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace clothsim {
@@ -120,6 +121,10 @@ public:
     double last_solver_residual() const;
     // The fast solver's kernels on this CPU (chosen at run time): "avx512", "avx2+fma" or "generic".
     static const char* fast_kernel_name();
+    // Runs the fast solver's (and grid XPBD's) kernels of `name` ("avx512", "avx2+fma" or "avx2", "generic")
+    // from now on, for benchmarks that compare them on one machine; false, changing nothing, when the name is
+    // unknown or this CPU lacks the instructions.
+    static bool use_fast_kernel(const std::string& name);
 
     // The stages the current settings run.
     const StepPlan& plan() const { return plan_; }
@@ -185,7 +190,7 @@ private:
     // Returns false when it moved no particle.
     bool collide(StepProfile* profile);
     // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
-    bool collide_self(StepProfile* profile, const MotionBounds* known);
+    bool collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted);
     void limit_strain();
     void limit_speed(double h);
     void tear();
@@ -245,6 +250,7 @@ private:
     DVec3Array rest_position_;   // m: the positions the cloth was built with (flat, at rest)
     Tethers tethers_;            // to the current pins, rebuilt when a pin is set or freed
     std::optional<SelfCollision> self_collision_;  // built when collision.self is first on
+    bool moved_uncounted_ = false;  // the last substep moved particles after its self stage, outside their motion
     std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
     double last_residual_ = 0.0;

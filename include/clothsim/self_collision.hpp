@@ -34,8 +34,11 @@
 // (a diagonal shrinks by at most as much as two particles close in; a vector area and a mean normal change
 // by at most a bound per unit of that, to first order). Each substep then takes the spread of the motions,
 // |max - min| over the particles per component, which bounds how much any two particles closed in, off the
-// budget, and tests again only when it is spent (or after kSelfSkipMax substeps). A cloth that falls or
-// rests as a whole spends almost none. The stage then costs one vectorised pass over the motions.
+// budget, and tests again only when it is spent. Moves that are not motions (a collider's push, a tether,
+// the strain or speed limit) are not counted: substeps that had any are covered by a test at most
+// kSelfSkipMax of them apart. And a test at least every kSelfSkipLimit substeps bounds what the fold
+// thresholds' first-order estimates leave out. A cloth that falls or rests as a whole spends almost none of
+// the budget; the stage then costs one vectorised pass over the motions (none when the sweep took them).
 // A test that finds pairs near each other lists every particle pair within d + kSelfSkin d (a Verlet
 // neighbour list with a skin, as molecular dynamics keeps one): until the particles closed in by the skin,
 // or a fold threshold of the tiles not in the narrow phase is reached, no other pair can come within d, so
@@ -57,7 +60,8 @@
 namespace clothsim {
 
 inline constexpr int kSelfTile = 4;  // particles along each side of a broad-phase tile
-inline constexpr int kSelfSkipMax = 64;           // substeps one box test that finds nothing covers at most
+inline constexpr int kSelfSkipMax = 64;           // substeps with uncounted moves one test covers at most
+inline constexpr int kSelfSkipLimit = 1024;       // substeps one test covers at most
 inline constexpr double kSelfLookAhead = 8.0;     // far gaps are measured out to d + kSelfLookAhead d
 inline constexpr double kSelfSkin = 0.5;          // a test lists the pairs within d + kSelfSkin d
 
@@ -86,10 +90,11 @@ public:
 
     // One substep of the stage on `state` (after integration and the colliders). `known`, when not null, is
     // the bounds of state.motion as it is now (the fast solver's sweep leaves them); otherwise the stage reads
-    // every motion once for them. Returns what it did; positions or motions changed when contacts or clamped
-    // is not 0.
+    // every motion once for them. `uncounted`: something besides the motions moved particles since the last
+    // substep (a collider's push, a tether, the strain or speed limit). Returns what it did; positions or
+    // motions changed when contacts or clamped is not 0.
     SelfCollisionCounts collide(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
-                                const MotionBounds* known = nullptr);
+                                const MotionBounds* known = nullptr, bool uncounted = true);
     // Something moved particles outside a step (an edit, a restart): the next substep tests afresh.
     void invalidate() { tested_distance_ = 0.0; }
 
@@ -138,6 +143,7 @@ private:
     std::vector<std::uint8_t> gathered_;
     double budget_ = 0.0;                   // closing left before the next test (conservative advancement)
     int skipped_ = 0;                       // substeps skipped since the last test
+    int skipped_uncounted_ = 0;             // of them, those with uncounted moves
     double tested_distance_ = 0.0;          // the d the last test was made for (0: none, test at the next substep)
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;

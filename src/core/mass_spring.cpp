@@ -105,6 +105,17 @@ MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
 
 const char* MassSpring::fast_kernel_name() { return FastSolver::kernel_name(); }
 
+bool MassSpring::use_fast_kernel(const std::string& name) {
+    for (FastKernel k : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
+        const bool named = name == FastSolver::kernel_name(k) || (k == FastKernel::Avx2 && name == "avx2");
+        if (!named) continue;
+        if (static_cast<int>(k) > static_cast<int>(FastSolver::best_kernel())) return false;
+        FastSolver::use_kernel(k);
+        return true;
+    }
+    return false;
+}
+
 int MassSpring::solver_threads() const {
     if (plan_.path != StepPath::Fast) {
         const bool grid = last_step_fast() && iterative_.data->grid_xpbd;
@@ -171,7 +182,9 @@ void MassSpring::step() {
     // With self-collision on, the fast solver's sweep takes the bounds of the motion it writes; they hold while
     // no collider moved a particle.
     const MotionBounds* known = plan_.path == StepPath::Fast && !collided ? &motion_bounds_ : nullptr;
-    const bool self_moved = plan_.self_collision && collide_self(profile, known);
+    // A collider's push (now, or after the last substep's self stage) moved particles outside their motion.
+    const bool self_moved = plan_.self_collision && collide_self(profile, known, collided || moved_uncounted_);
+    moved_uncounted_ = false;
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
@@ -186,7 +199,8 @@ void MassSpring::step() {
             limit_speed(h);
         }
         blocks_.current = blocks_.boxes_current = false;
-        collide(profile);  // a push or a correction must not leave a particle inside a collider
+        const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
+        moved_uncounted_ = pushed || (plan_.tethers && tethers_at_limit_ > 0) || plan_.strain_limit || plan_.speed_limit;
     }
     state_.time += h;
     ++profile_.substeps;
@@ -248,10 +262,10 @@ bool MassSpring::collide(StepProfile* profile) {
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.
-bool MassSpring::collide_self(StepProfile* profile, const MotionBounds* known) {
+bool MassSpring::collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted) {
     StageTimer timer(profile, Stage::SelfCollision);
     if (!self_collision_) self_collision_.emplace(topology_, rest_position_);
-    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_, known);
+    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_, known, uncounted);
     if (profile) {
         profile->self_tiles += counts.tiles;
         profile->self_tiles_active += counts.tiles_active;

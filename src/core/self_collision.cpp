@@ -345,7 +345,8 @@ void SelfCollision::gather(std::uint32_t t, const State& state, TilePoints& out)
 }
 
 SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings& settings,
-                                           const DVec3Array& rest_position, const MotionBounds* known) {
+                                           const DVec3Array& rest_position, const MotionBounds* known,
+                                           bool uncounted) {
     SelfCollisionCounts counts;
     const double d = contact_distance(settings);
     if (!(d > 0.0) || particles_ != state.size()) return counts;
@@ -377,10 +378,12 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     // these spreads of motions (and of the pushes below), and the test left room for `budget_` of it. Until
     // it is spent, the particle pairs it listed (all within d + skin then) are the only ones that can touch.
     const double skin = kSelfSkin * d;
-    if (tested_distance_ == d && !clamped && skipped_ < kSelfSkipMax) {
+    if (tested_distance_ == d && !clamped && skipped_ < kSelfSkipLimit &&
+        skipped_uncounted_ + (uncounted ? 1 : 0) <= kSelfSkipMax) {
         budget_ -= range.spread();
         if (budget_ > 0.0) {
             ++skipped_;
+            if (uncounted) ++skipped_uncounted_;
             counts.tiles_active = listed_tiles_;
             resolve(state, settings, rest_position, d, counts);
             return counts;
@@ -392,7 +395,7 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     const std::size_t marked = mark_active(state.position, static_cast<float>(d), static_cast<float>(skin),
                                            static_cast<float>((1.0 + kSelfLookAhead) * d), budget);
     budget_ = budget;
-    skipped_ = 0;
+    skipped_ = skipped_uncounted_ = 0;
     tested_distance_ = d;
     candidates_.clear();
     listed_tiles_ = 0;

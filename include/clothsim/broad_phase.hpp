@@ -36,6 +36,9 @@ Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t e
 // self-collision's pass when the fast solver's sweep did not leave them (fast_solver.hpp).
 void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end, MotionBounds& bounds);
 
+// The box around boxes[0, n) (empty for n = 0), as glm::min and glm::max fold them: a NaN bound is left out.
+Box union_of(const Box* boxes, std::size_t n);
+
 // The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles.
 void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out);
 

@@ -179,4 +179,25 @@ bool may_touch(const GroundCollider& ground, float thickness, const Box& box) {
     return box.lo.y < top + margin(std::abs(top) + std::abs(box.lo.y));
 }
 
+Box union_of(const Box* boxes, std::size_t n) {
+    static_assert(sizeof(Box) == 6 * sizeof(float), "a Box is lo then hi, three floats each");
+    Box all;
+    if (n == 0) return all;
+    // Four floats from each bound (the fourth lane, the next float in memory, is ignored); the last box alone,
+    // so no load reads past the array. MINPS(v, lo) returns lo when either is NaN: glm::min(lo, v)'s
+    // (v < lo ? v : lo).
+    __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+        lo = _mm_min_ps(_mm_loadu_ps(&boxes[k].lo.x), lo);
+        hi = _mm_max_ps(_mm_loadu_ps(&boxes[k].hi.x), hi);
+    }
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    all.lo = glm::min(glm::vec3(l[0], l[1], l[2]), boxes[n - 1].lo);
+    all.hi = glm::max(glm::vec3(h[0], h[1], h[2]), boxes[n - 1].hi);
+    return all;
+}
+
+
 }  // namespace clothsim

@@ -325,17 +325,15 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
             const Box motion = particle_bounds(state.motion, 0, state.size());
             if (!motion.empty()) reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
         }
-        for (std::size_t k = 0; k < count; ++k) {
-            Box& box = blocks.boxes[k];
-            if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
-            box.lo -= reach;
-            box.hi += reach;
+        if (!from_sweep || reach != glm::vec3(0.0f)) {
+            for (std::size_t k = 0; k < count; ++k) {
+                Box& box = blocks.boxes[k];
+                if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
+                box.lo -= reach;
+                box.hi += reach;
+            }
         }
-        blocks.cloth = Box{};
-        for (const Box& b : blocks.boxes) {
-            blocks.cloth.lo = glm::min(blocks.cloth.lo, b.lo);
-            blocks.cloth.hi = glm::max(blocks.cloth.hi, b.hi);
-        }
+        blocks.cloth = union_of(blocks.boxes.data(), count);
         blocks.boxes_current = blocks.current = true;
     }
     const float thickness = colliders.thickness;

@@ -155,6 +155,33 @@ TEST_CASE("broad_phase particle_bounds is the box of the finite coordinates of i
     CHECK_FALSE(may_touch(GroundCollider{true, 1e6f, 0.0f}, 1.0f, none));
 }
 
+TEST_CASE("broad_phase union_of is the box around its boxes, a NaN bound left out, as folding glm::min and glm::max",
+          "[broad_phase]") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> coord(-5.0f, 5.0f);
+    std::uniform_int_distribution<int> pick(0, 19);
+    for (std::size_t n : {0u, 1u, 2u, 3u, 17u, 256u}) {
+        std::vector<Box> boxes(n);
+        for (Box& b : boxes) {
+            const int kind = pick(rng);
+            if (kind == 0) continue;  // empty
+            b.lo = glm::vec3(coord(rng), coord(rng), coord(rng));
+            b.hi = b.lo + glm::vec3(1.0f);
+            if (kind == 1) b.lo.y = NAN;
+            if (kind == 2) b.hi.z = NAN;
+        }
+        Box plain;
+        for (const Box& b : boxes) plain.lo = glm::min(plain.lo, b.lo), plain.hi = glm::max(plain.hi, b.hi);
+        const Box fast = union_of(boxes.data(), n);
+        INFO(n << " boxes");
+        for (int c = 0; c < 3; ++c) {
+            CHECK(fast.lo[c] == plain.lo[c]);  // never NaN: NaN bounds are left out by both
+            CHECK(fast.hi[c] == plain.hi[c]);
+        }
+        if (n == 0) CHECK(fast.empty());
+    }
+}
+
 TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles and row_block_bounds boxes them",
           "[broad_phase]") {
     // A grid: every row on its own, cut into runs of at most kBlockParticles, in row order.

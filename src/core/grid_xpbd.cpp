@@ -177,8 +177,8 @@ template <int Span>
         const bool mine = column[c] % 3 == phase;
         const double s = mine ? -1.0 / (((wa + 4.0 * wm) + wb) + alpha[c]) : 0.0;
         // Counted where the bend is projected: s is 0 for another phase's bend and -0 for one without stiffness
-        // (alpha infinite). A mask of `mine & (alpha < kInfinite)` here made GCC 12's AVX2 build of this loop
-        // sum wrong values into the reduction (the positions were right); tested against the list order.
+        // (alpha infinite). With a mask of `mine & (alpha < kInfinite)` here, GCC 12's AVX2 and AVX-512 builds of
+        // this loop summed wrong values (the positions were right); tested against the list order.
         violation2 += s != 0.0 ? (cx * cx + cy * cy) + cz * cz : 0.0;
         const double lax = cx * s, lay = cy * s, laz = cz * s;
         lx[c] = mine ? lax : lx[c];

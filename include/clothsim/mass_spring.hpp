@@ -123,7 +123,7 @@ public:
     static const char* fast_kernel_name();
     // Runs the fast solver's (and grid XPBD's) kernels of `name` ("avx512", "avx2+fma" or "avx2", "generic")
     // from now on, for benchmarks that compare them on one machine; false, changing nothing, when the name is
-    // unknown or this CPU lacks the instructions.
+    // unknown or this CPU lacks the instructions. Not thread-safe: call it before any simulation steps.
     static bool use_fast_kernel(const std::string& name);
 
     // The stages the current settings run.
@@ -191,8 +191,9 @@ private:
     bool collide(StepProfile* profile);
     // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
     bool collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted);
-    void limit_strain();
-    void limit_speed(double h);
+    // Each returns whether it moved a particle.
+    bool limit_strain();
+    bool limit_speed(double h);
     void tear();
     // After springs broke: everything that follows the topology, at the point of change.
     void topology_changed(std::size_t removed);

@@ -35,8 +35,9 @@
 // by at most a bound per unit of that, to first order). Each substep then takes the spread of the motions,
 // |max - min| over the particles per component, which bounds how much any two particles closed in, off the
 // budget, and tests again only when it is spent. Moves that are not motions (a collider's push, a tether,
-// the strain or speed limit) are not counted: substeps that had any are covered by a test at most
-// kSelfSkipMax of them apart. And a test at least every kSelfSkipLimit substeps bounds what the fold
+// the strain or speed limit, and the steps of RK4 and projective, whose motion is v h rather than the
+// displacement) are not counted: substeps that had any are covered by a test at most kSelfSkipMax of them
+// apart. And a test at least every kSelfSkipLimit substeps bounds what the fold
 // thresholds' first-order estimates leave out. A cloth that falls or rests as a whole spends almost none of
 // the budget; the stage then costs one vectorised pass over the motions (none when the sweep took them).
 // A test that finds pairs near each other lists every particle pair within d + kSelfSkin d (a Verlet

@@ -28,6 +28,16 @@ enum class Integrator {
     Projective,       // BDF2 solved by projective dynamics on a prefactorised matrix: the stiff-cloth solver
 };
 
+// What an integrator's solve reads and reports, in one place for the panel, --json and the tests.
+// Reports its iterations and a relative residual (MassSpring::last_solver_iterations and _residual).
+constexpr bool reports_solve(Integrator i) {
+    return i == Integrator::ImplicitEuler || i == Integrator::Projective || i == Integrator::Xpbd;
+}
+// Reads integration.tolerance: implicit Euler's CG and projective's quasi-Newton iterations stop there.
+constexpr bool uses_tolerance(Integrator i) { return i == Integrator::ImplicitEuler || i == Integrator::Projective; }
+// Reads integration.iterations: projective's most iterations per substep (XPBD makes one pass, always).
+constexpr bool uses_iterations(Integrator i) { return i == Integrator::Projective; }
+
 // The outline of the cloth on its grid.
 enum class ClothShape {
     Rectangle,  // every particle of the rows x cols grid

@@ -192,8 +192,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"path", sim.last_step_fast() ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
         {"threads", sim.solver_threads()},
     };
-    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
-        integrator == Integrator::Xpbd) {
+    if (reports_solve(integrator)) {
         // Last substep (MassSpring::last_solver_residual): CG (implicit-euler), quasi-Newton (projective) or
         // constraint (xpbd) iterations and relative residual.
         solver["iterations"] = sim.last_solver_iterations();

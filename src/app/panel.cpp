@@ -226,11 +226,25 @@ bool fields_section(Scene& edit, AppState& app, std::string_view prefix) {
         // is not silently overwritten.
         const bool owned = (app.stepper.policy().auto_substeps && f.name == "integration.substeps") ||
                            (edit.material.enabled && !field_is_written(edit, f.name));
+        // A solver setting the chosen integrator does not read stays editable but dimmed (as Blender shows an
+        // inactive property), and its tooltip says so.
+        const Integrator integrator = edit.settings.integration.integrator;
+        const bool unused = (f.name == "integration.tolerance" && !uses_tolerance(integrator)) ||
+                            (f.name == "integration.iterations" && !uses_iterations(integrator));
         if (owned) ImGui::BeginDisabled();
+        if (unused) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, ImGui::GetStyle().Alpha * 0.45f);
         if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
             keep_in_range(app, edit, f);
             note_edit(edit, f);
             changed = true;
+        }
+        if (unused) {
+            ImGui::PopStyleVar();
+            if (ImGui::IsItemHovered()) {
+                ImGui::SetTooltip("%s does not read %s",
+                                  std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
+                                  std::string(f.name).c_str());
+            }
         }
         if (owned && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled) && edit.material.enabled &&
             !f.name.starts_with("integration.")) {
@@ -617,8 +631,7 @@ void stats_section(const AppState& app) {
     // contact it should stay put, and its drift measures the integrator's error at this step.
     const Integrator integrator = app.sim.settings().integration.integrator;
     ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
-                integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
-                        integrator == Integrator::Xpbd
+                reports_solve(integrator)
                     ? ((integrator == Integrator::ImplicitEuler ? ", CG " : ", ") +
                        std::to_string(app.sim.last_solver_iterations()) + " iterations, residual " +
                        [&] {

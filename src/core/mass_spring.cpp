@@ -144,6 +144,9 @@ void MassSpring::apply(const SimulationSettings& settings) {
     settings_ = settings;
     replan();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
+    // Self-collision's list and budget say nothing of what the cloth did while the stage was off or set
+    // otherwise: it tests afresh at its next substep.
+    if (self_collision_) self_collision_->invalidate();
     setup_stamp_ = next_stamp();
 }
 
@@ -182,25 +185,30 @@ void MassSpring::step() {
     // With self-collision on, the fast solver's sweep takes the bounds of the motion it writes; they hold while
     // no collider moved a particle.
     const MotionBounds* known = plan_.path == StepPath::Fast && !collided ? &motion_bounds_ : nullptr;
-    // A collider's push (now, or after the last substep's self stage) moved particles outside their motion.
-    const bool self_moved = plan_.self_collision && collide_self(profile, known, collided || moved_uncounted_);
+    // Moves outside the motions, which self-collision's budget does not count: a collider's push now, what
+    // the stages after the last substep's self stage did, and the steps of RK4 and projective, whose motion
+    // (v h at the substep's end) is not the substep's displacement.
+    const bool displaced = integrator == Integrator::Rk4 || integrator == Integrator::Projective;
+    const bool self_moved =
+        plan_.self_collision && collide_self(profile, known, collided || moved_uncounted_ || displaced);
     moved_uncounted_ = false;
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
             tethers_at_limit_ = project_tethers(state_, tethers_, settings_.springs.tether_strain);
         }
+        bool limited = false;
         if (plan_.strain_limit) {
             StageTimer timer(profile, Stage::StrainLimit);
-            limit_strain();
+            limited = limit_strain();
         }
         if (plan_.speed_limit) {
             StageTimer timer(profile, Stage::SpeedLimit);
-            limit_speed(h);
+            limited = limit_speed(h) || limited;
         }
         blocks_.current = blocks_.boxes_current = false;
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
-        moved_uncounted_ = pushed || (plan_.tethers && tethers_at_limit_ > 0) || plan_.strain_limit || plan_.speed_limit;
+        moved_uncounted_ = pushed || limited || (plan_.tethers && tethers_at_limit_ > 0);
     }
     state_.time += h;
     ++profile_.substeps;
@@ -376,8 +384,9 @@ void MassSpring::check_sleep(double h) {
 // adds no velocity of its own (like a collision push), and the ends' motion apart along the spring is
 // removed, shared by inverse mass so momentum is kept: a spring held at its limit stops stretching instead
 // of storing speed it cannot use. It changes the model where it acts (docs/STABILITY.md).
-void MassSpring::limit_strain() {
+bool MassSpring::limit_strain() {
     const double limit = settings_.springs.strain_limit;
+    bool changed = false;
     for (const Spring& s : topology_.springs) {
         if (s.rest_length == 0.0f) continue;
         const double wa = state_.inverse_mass[s.a], wb = state_.inverse_mass[s.b];
@@ -387,6 +396,7 @@ void MassSpring::limit_strain() {
         const double longest = (1.0 + limit) * s.rest_length;
         if (!(length > longest)) continue;
         const glm::dvec3 shorten = d * ((length - longest) / (length * (wa + wb)));
+        changed = true;
         state_.position.add(s.a, wa * shorten);
         state_.position.add(s.b, -wb * shorten);
         const glm::dvec3 n = d / length;
@@ -396,11 +406,13 @@ void MassSpring::limit_strain() {
             state_.motion.add(s.b, -(wb / (wa + wb)) * apart * n);
         }
     }
+    return changed;
 }
 
 // Any particle moving faster than max_speed is slowed to it, its substep's displacement shortened with it.
-void MassSpring::limit_speed(double h) {
+bool MassSpring::limit_speed(double h) {
     const double longest_step = settings_.forces.max_speed * h;
+    bool changed = false;
     for (std::size_t i = 0; i < state_.size(); ++i) {
         const glm::dvec3 m = state_.motion.get(i);
         const double step = glm::length(m);
@@ -408,7 +420,9 @@ void MassSpring::limit_speed(double h) {
         const glm::dvec3 clamped = m * (longest_step / step);
         state_.position.add(i, clamped - m);  // the substep moved the particle by m: move it by clamped
         state_.motion.set(i, clamped);
+        changed = true;
     }
+    return changed;
 }
 
 // One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.

@@ -170,3 +170,32 @@ TEST_CASE("integrators XPBD reports its constraint residual: none for one spring
     CHECK(cloth.last_solver_residual() > 1e-3);
     CHECK(cloth.last_solver_residual() < 1.0);
 }
+
+TEST_CASE("integrators read integration.tolerance and integration.iterations exactly where settings.hpp says they do",
+          "[integrators]") {
+    // The panel dims the two fields for an integrator that does not read them (uses_tolerance, uses_iterations):
+    // a run that changes only the field differs exactly when the integrator reads it.
+    for (Integrator integrator : {Integrator::Verlet, Integrator::SymplecticEuler, Integrator::Rk4,
+                                  Integrator::ImplicitEuler, Integrator::Xpbd, Integrator::Projective}) {
+        Scene s = per_spring_scene("hanging");
+        s.cloth.rows = s.cloth.cols = 10;
+        s.settings.integration.integrator = integrator;
+        s.settings.integration.substeps = 4;
+        s.settings.integration.tolerance = 1e-9f;
+        s.settings.integration.iterations = 40;
+        MassSpring base = build_simulation(s);
+        Scene looser = s;  // stops earlier where the tolerance is read
+        looser.settings.integration.tolerance = 1e-2f;
+        Scene fewer = s;  // stops earlier where the iterations are read
+        fewer.settings.integration.iterations = 2;
+        MassSpring by_tolerance = build_simulation(looser);
+        MassSpring by_iterations = build_simulation(fewer);
+        base.run_steps(5);
+        by_tolerance.run_steps(5);
+        by_iterations.run_steps(5);
+        INFO(integrator_names()[static_cast<int>(integrator)]);
+        CHECK(test::bit_identical(base, by_tolerance) == !uses_tolerance(integrator));
+        CHECK(test::bit_identical(base, by_iterations) == !uses_iterations(integrator));
+        CHECK((base.last_solver_iterations() > 0) == reports_solve(integrator));
+    }
+}

@@ -290,3 +290,48 @@ TEST_CASE("self-collision: off by default, and the plan says so", "[self-collisi
     }
     CHECK(said);
 }
+
+TEST_CASE("self-collision: substeps with moves outside the motions are tested at least every kSelfSkipMax, others "
+          "every kSelfSkipLimit", "[self-collision]") {
+    // A flat cloth at rest: its motions spread nothing, so only the caps bring the next test.
+    Scene scene = load_scene("falling");
+    scene.cloth.v_axis = glm::vec3(0.0f, 0.0f, 1.0f);  // flat
+    const MassSpring sim = build_simulation(scene);
+    const DVec3Array rest = sim.state().position;
+    State still = sim.state();
+    for (std::size_t i = 0; i < still.size(); ++i) still.motion.set(i, glm::dvec3(0.0));
+    CollisionSettings settings = sim.settings().collision;
+    settings.self = true;
+    auto tests = [&](bool uncounted, int substeps) {
+        SelfCollision stage(sim.topology(), rest);
+        int count = 0;
+        for (int k = 0; k < substeps; ++k) {
+            State state = still;
+            count += stage.collide(state, settings, rest, nullptr, uncounted).tiles > 0 ? 1 : 0;
+        }
+        return count;
+    };
+    // A test, then kSelfSkipMax skips, then the next test: every (kSelfSkipMax + 1)th substep.
+    CHECK(tests(true, 3 * (kSelfSkipMax + 1) + 1) == 4);
+    CHECK(tests(false, 3 * (kSelfSkipMax + 1) + 1) == 1);
+    CHECK(tests(false, 2 * (kSelfSkipLimit + 1) + 1) == 3);
+}
+
+TEST_CASE("self-collision: turned off and on again, it tests at its first substep", "[self-collision]") {
+    // What the cloth did while the stage was off is in no budget: the list of the last test is stale.
+    Scene scene = load_scene("falling");
+    scene.cloth.v_axis = glm::vec3(0.0f, 0.0f, 1.0f);
+    scene.settings.collision.self = true;
+    MassSpring sim = build_simulation(scene);
+    sim.run_steps(2);
+    SimulationSettings off = sim.settings();
+    off.collision.self = false;
+    sim.apply(off);
+    sim.run_steps(2);
+    SimulationSettings on = off;
+    on.collision.self = true;
+    sim.apply(on);
+    const long long tiles = sim.profile().self_tiles;
+    sim.step();
+    CHECK(sim.profile().self_tiles > tiles);
+}

@@ -37,9 +37,9 @@
 // budget, and tests again only when it is spent. Moves that are not motions (a collider's push, a tether,
 // the strain or speed limit, and the steps of RK4 and projective, whose motion is v h rather than the
 // displacement) are not counted: substeps that had any are covered by a test at most kSelfSkipMax of them
-// apart. And a test at least every kSelfSkipLimit substeps bounds what the fold
-// thresholds' first-order estimates leave out. A cloth that falls or rests as a whole spends almost none of
-// the budget; the stage then costs one vectorised pass over the motions (none when the sweep took them).
+// apart. And a test at least every kSelfSkipLimit substeps bounds what the fold thresholds' first-order
+// estimates leave out. A cloth that falls or rests as a whole spends almost none of the budget; the stage
+// then costs one vectorised pass over the motions (none when the sweep took them).
 // A test that finds pairs near each other lists every particle pair within d + kSelfSkin d (a Verlet
 // neighbour list with a skin, as molecular dynamics keeps one): until the particles closed in by the skin,
 // or a fold threshold of the tiles not in the narrow phase is reached, no other pair can come within d, so
@@ -92,8 +92,8 @@ public:
     // One substep of the stage on `state` (after integration and the colliders). `known`, when not null, is
     // the bounds of state.motion as it is now (the fast solver's sweep leaves them); otherwise the stage reads
     // every motion once for them. `uncounted`: something besides the motions moved particles since the last
-    // substep (a collider's push, a tether, the strain or speed limit). Returns what it did; positions or
-    // motions changed when contacts or clamped is not 0.
+    // substep (see the skipping above). Returns what it did; positions or motions changed when contacts or
+    // clamped is not 0.
     SelfCollisionCounts collide(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
                                 const MotionBounds* known = nullptr, bool uncounted = true);
     // Something moved particles outside a step (an edit, a restart): the next substep tests afresh.

@@ -22,6 +22,10 @@
 
 namespace clothsim {
 
+// What sets the critical substep: the springs (explicit integrators), or, where the springs are implicit,
+// XPBD's explicit damping (c h < 2) or penalty contact.
+enum class StabilityBound { Springs, Damping, Contact };
+
 struct StabilityLimit {
     double omega_gershgorin = 0.0;  // rad/s, the safe bound on the fastest mode
     double omega_plane_wave = 0.0;  // rad/s, the tighter grid bound
@@ -29,6 +33,7 @@ struct StabilityLimit {
     double plane_wave_substep = 0.0;  // s: the same with the plane-wave bound
     double wind_substep = 0.0;      // s: the explicit limit of the wind's drag, 1 / rate (inf without wind)
     bool unconditionally_stable = false;  // implicit Euler, XPBD
+    StabilityBound bound = StabilityBound::Springs;
 };
 
 // For the cloth's current stiffness, masses, damping and integrator.

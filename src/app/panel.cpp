@@ -530,14 +530,10 @@ void stability_lines(AppState& app) {
     const ImVec4 colour = fraction < 0.7   ? ImVec4(0.6f, 0.9f, 0.6f, 1.0f)
                           : fraction < 1.0 ? ImVec4(1.0f, 0.85f, 0.3f, 1.0f)
                                            : ImVec4(1.0f, 0.4f, 0.35f, 1.0f);
-    if (reports_solve(integration.integrator)) {
-        // The springs are implicit: what limits the substep is XPBD's explicit damping or penalty contact
-        // (stability.hpp); a plane wave of the springs does not.
-        const float c = app.sim.settings().springs.damping;
-        const bool damping = integration.integrator == Integrator::Xpbd && c > 0.0f &&
-                             limit.critical_substep == 2.0 / static_cast<double>(c);
+    if (limit.bound != StabilityBound::Springs) {
+        // The springs are implicit: a plane wave of them sets no limit (stability.hpp).
         ImGui::Text("critical substep %.4g ms (%s)", 1e3 * limit.critical_substep,
-                    damping ? "damping: c h < 2" : "penalty contact");
+                    limit.bound == StabilityBound::Damping ? "damping: c h < 2" : "penalty contact");
     } else {
         ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
                     1e3 * limit.plane_wave_substep);

@@ -199,5 +199,4 @@ Box union_of(const Box* boxes, std::size_t n) {
     return all;
 }
 
-
 }  // namespace clothsim

@@ -60,6 +60,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective) {
         limit.unconditionally_stable = !std::isfinite(contact_substep);
         limit.critical_substep = limit.plane_wave_substep = contact_substep;
+        limit.bound = StabilityBound::Contact;
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
@@ -68,6 +69,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         // decay rate c, stable while c h < 2.
         const double damping_substep = c > 0.0 ? 2.0 / c : std::numeric_limits<double>::infinity();
         limit.critical_substep = limit.plane_wave_substep = std::min(damping_substep, contact_substep);
+        limit.bound = damping_substep <= contact_substep ? StabilityBound::Damping : StabilityBound::Contact;
         limit.unconditionally_stable = !std::isfinite(limit.critical_substep);
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;

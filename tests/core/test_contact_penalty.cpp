@@ -294,12 +294,22 @@ TEST_CASE("penalty contact: the stability limit counts 3 k_c per enabled collide
     CHECK(penalty.omega_plane_wave * penalty.omega_plane_wave ==
           Approx(projection.omega_plane_wave * projection.omega_plane_wave + added).epsilon(1e-9));
     CHECK(penalty.critical_substep < projection.critical_substep);
+    CHECK(penalty.bound == StabilityBound::Springs);  // explicit: the contact adds to the springs' bound
 
     // Implicit Euler takes the contact explicitly: no longer unconditionally stable, w_c h < 2.
     settings.integration.integrator = Integrator::ImplicitEuler;
     const StabilityLimit implicit = stability_limit(sim.topology(), sim.state(), settings);
     CHECK_FALSE(implicit.unconditionally_stable);
     CHECK(implicit.critical_substep == Approx(2.0 / std::sqrt(added)).epsilon(1e-9));
+    CHECK(implicit.bound == StabilityBound::Contact);
+    // XPBD's damping limit 2 / c against the contact's: the smaller one is named.
+    settings.integration.integrator = Integrator::Xpbd;
+    settings.springs.damping = 0.5f;  // 4 s: far above the contact's limit
+    CHECK(stability_limit(sim.topology(), sim.state(), settings).bound == StabilityBound::Contact);
+    settings.springs.damping = static_cast<float>(10.0 * std::sqrt(added));  // 2 / c well below it
+    CHECK(stability_limit(sim.topology(), sim.state(), settings).bound == StabilityBound::Damping);
+    settings.integration.integrator = Integrator::ImplicitEuler;
+    settings.springs.damping = sim.settings().springs.damping;
     settings.colliders.contact = ContactModel::Projection;
     CHECK(stability_limit(sim.topology(), sim.state(), settings).unconditionally_stable);
 

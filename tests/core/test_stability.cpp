@@ -908,6 +908,7 @@ TEST_CASE("stability damping limits the explicit parts of XPBD and RK4, and auto
         INFO("integrator " << int(integrator) << ", damping " << damping << ": critical " << limit.critical_substep);
         CHECK_FALSE(limit.unconditionally_stable);
         CHECK(limit.critical_substep * damping <= 2.785 + 1e-9);
+        CHECK(limit.bound == (integrator == Integrator::Xpbd ? StabilityBound::Damping : StabilityBound::Springs));
         sim.set_substeps(auto_substeps(limit, sim.settings().integration.dt, 0.5f));
         sim.run_steps(20);
         CHECK(sim.all_finite());

@@ -3,10 +3,16 @@
 // The model (Bridson, Fedkiw & Anderson 2002 for a thickness kept between layers; Müller's Ten Minute
 // Physics tutorial 15, "self-collision", for the particle form and its hash):
 //  - Every particle is a ball of diameter d, the contact distance: collision.self_thickness, raised to the
-//    cloth's particle spacing s when it is smaller. Two particles that share no spring and come closer
-//    than min(d, their rest distance) are pushed apart to it, each by its share of the inverse mass; their
-//    approach along the line between them is removed from their motion (an inelastic contact) and their
-//    sliding is slowed by Coulomb friction (collision.self_friction), both without changing the momentum.
+//    cloth's particle spacing s when it is smaller. Two particles that share no spring (strangers) and
+//    come closer than min(d, their rest distance) are pushed apart to it, each by its share of the inverse
+//    mass; their approach along the line between them is removed from their motion (an inelastic contact)
+//    and their sliding is slowed by Coulomb friction (collision.self_friction), both without changing the
+//    momentum.
+//  - Fold pairs, the two ends of a skip-one bending spring or of a bend (2 s apart at rest), are kept
+//    min(d, rest / 2) apart the same way. Without it a crease sharper than the grid turns inside out: the
+//    particles on either side of the fold line pass each other, and triangles one or two rows apart cross
+//    (docs/SELF_COLLISION.md has the counts). At half its rest distance a fold pair keeps the angle at its
+//    middle particle above 60 degrees. Particles a structural or shear spring joins never collide.
 //  - Why d >= s keeps layers from crossing: the balls of a flat layer then cover a slab of half-thickness
 //    sqrt(d^2 - s^2 / 2) >= s / sqrt(2) around it, so a particle of another layer that keeps out of every
 //    ball stays on its side, and a triangle of that layer cannot straddle the slab unless an edge of
@@ -26,8 +32,8 @@
 //    under 0.8 of its rest diagonal (a box's diagonal is at least the distance between any two of its
 //    particles: an accordion buckle that leaves each tile's normal alone).
 // The narrow phase compares every particle of one tile with every particle of the other (16 x 16, four at
-// a time in float), keeps the pairs within d that share no spring, and resolves them in index order in
-// double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.
+// a time in float), keeps the pairs that may touch (see the list below), and resolves them in index order
+// in double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.
 // Skipping (conservative advancement, as Mirtich 1996 and Tang et al. 2009 advance bodies by a bound on
 // their approach): a test that finds nothing also measures the room left, the budget: the smallest gap
 // between far tile boxes within d + kSelfLookAhead d, less d, and how far each fold threshold still is
@@ -40,10 +46,12 @@
 // apart. And a test at least every kSelfSkipLimit substeps bounds what the fold thresholds' first-order
 // estimates leave out. A cloth that falls or rests as a whole spends almost none of the budget; the stage
 // then costs one vectorised pass over the motions (none when the sweep took them).
-// A test that finds pairs near each other lists every particle pair within d + kSelfSkin d (a Verlet
-// neighbour list with a skin, as molecular dynamics keeps one): until the particles closed in by the skin,
-// or a fold threshold of the tiles not in the narrow phase is reached, no other pair can come within d, so
-// the substeps between tests only resolve the listed pairs. The pushes themselves move particles outside
+// A test that finds pairs near each other lists every particle pair within its kept distance + a skin,
+// kSelfSkin d (at most half the kept distance for a fold pair): a Verlet neighbour list, as molecular
+// dynamics keeps one. Until the particles closed in by the skin, or a fold threshold of the tiles not in
+// the narrow phase is reached, no other pair can come within its kept distance, so the substeps between
+// tests only resolve the listed pairs. Fold pairs are a threshold of their own: one within its kept
+// distance plus its skin puts both its tiles in the narrow phase (a crease sharper than a tile). The pushes themselves move particles outside
 // their motion, so what they moved comes off the budget too.
 #pragma once
 
@@ -83,7 +91,7 @@ public:
     // The tiles, each particle's spring neighbours and the particle spacing, from the cloth as built.
     SelfCollision(const Topology& topology, const DVec3Array& rest_position);
     // After a tear: the neighbours follow the springs that are left (the spacing stays the built cloth's).
-    void update_neighbours(const Topology& topology);
+    void update_neighbours(const Topology& topology, const DVec3Array& rest_position);
 
     // The contact distance d for these settings: max(self_thickness, spacing).
     double contact_distance(const CollisionSettings& settings) const;
@@ -103,8 +111,14 @@ public:
     // the last test.
     const std::vector<std::uint64_t>& listed_pairs() const { return candidates_; }
 
-    // Whether particles i and j share a spring or a bend (then they never collide).
+    // Whether particles i and j share a spring or a bend.
     bool neighbours(std::uint32_t i, std::uint32_t j) const;
+    // Whether i and j are a fold pair: the ends of a bending spring or a bend.
+    bool fold_pair(std::uint32_t i, std::uint32_t j) const;
+    // The least distance the stage keeps between particles i and j for contact distance d (rest: their
+    // distance in `rest_position`): min(d, rest) for strangers, min(d, rest / 2) for a fold pair, 0 (none)
+    // for other neighbours.
+    double kept_distance(std::uint32_t i, std::uint32_t j, double d, const DVec3Array& rest_position) const;
 
 private:
     struct TilePoints {
@@ -122,6 +136,10 @@ private:
     std::vector<std::uint32_t> neighbour_begin_, neighbour_;  // sorted spring neighbours of each particle
     std::vector<std::uint32_t> near_mask_;  // grid: bit (dr + 2) * 5 + dc + 2 set for a neighbour at (dr, dc)
     bool far_links_ = false;                // grid: some link spans more than two rows or columns
+    std::vector<std::uint64_t> fold_pairs_;   // (i << 32 | j), i < j: the fold pairs (sorted off the grid)
+    std::vector<double> fold_half_rest_;      // half the rest distance of each
+    std::vector<std::uint32_t> fold_mask_;    // grid: as near_mask_, the fold pairs only
+    std::array<double, 25> longest_fold_half_rest_{};  // grid: the longest half rest distance at (dr, dc)
     bool near_neighbours(std::uint32_t i, int dr, int dc) const {
         return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((near_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
     }
@@ -136,7 +154,8 @@ private:
     std::vector<glm::vec3> normal_;         // grid: each tile's mean normal
     std::vector<double> area_, diagonals_;  // grid: each tile's |vector area| and |D1| + |D2|
     std::vector<std::uint64_t> tile_pairs_; // (a << 32 | b), a <= b: the tile pairs the narrow phase tests
-    std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within d + skin at the last test
+    std::vector<std::uint64_t> candidates_; // (i << 32 | j), i < j: particle pairs within reach at the last test
+    std::vector<double> candidate_kept_;    // each candidate's kept distance
     long long listed_tiles_ = 0;            // tiles the last test sent to the narrow phase
     std::vector<double> pushed_;            // per particle, how far the pushes of this substep moved it (m)
     std::vector<std::uint32_t> pushed_list_; // the particles pushed this substep
@@ -148,13 +167,14 @@ private:
     double tested_distance_ = 0.0;          // the d the last test was made for (0: none, test at the next substep)
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;
+    std::uint32_t tile_of(std::uint32_t particle) const;
     void tile_boxes(const DVec3Array& position);
     // Lists the tile pairs the narrow phase tests: far tiles within d + skin of each other, and each folded
     // tile with itself and its neighbours. Returns how many tiles it marked, and in `budget` the closing the
     // next substeps may spend before a test is needed again (the skin at most when it marked some).
     std::size_t mark_active(const DVec3Array& position, float d, float skin, float reach, double& budget);
-    // Pushes apart the listed pairs that are closer than min(d, rest distance); the pushes come off the budget.
-    void resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position, double d,
+    // Pushes apart the listed pairs closer than their kept distance; the pushes come off the budget.
+    void resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
                  SelfCollisionCounts& counts);
     void gather(std::uint32_t t, const State& state, TilePoints& out) const;
 };

@@ -1,6 +1,7 @@
 #include "headless.hpp"
 
 #include "clothsim/export.hpp"
+#include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 #include "clothsim/step_plan.hpp"
@@ -183,6 +184,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"tethers", sim.tether_count()},
         {"tethers_at_limit", sim.plan().tethers ? sim.tethers_at_limit() : 0},
         {"broken_springs", sim.broken_springs()},
+        {"self_intersections", intersecting_triangle_pairs(sim.topology(), sim.positions())},
         {"profile", profile_json(sim.profile(), stages, run.steps, sim.asleep())},
     };
     // Which solver ran and, for an iterative one, how far its last solve got.

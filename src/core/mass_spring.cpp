@@ -302,7 +302,7 @@ void MassSpring::topology_changed(std::size_t removed) {
     broken_springs_ += removed;
     build_fast_solver();
     iterative_.invalidate();
-    if (self_collision_) self_collision_->update_neighbours(topology_);
+    if (self_collision_) self_collision_->update_neighbours(topology_, rest_position_);
     rebuild_tethers();
     replan();
     setup_stamp_ = next_stamp();

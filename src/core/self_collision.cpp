@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace clothsim {
 namespace {
@@ -56,7 +57,7 @@ SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_po
         tile_cols_ = static_cast<int>((particles_ + kSelfTileParticles - 1) / kSelfTileParticles);
     }
     spacing_ = particle_spacing(topology);
-    update_neighbours(topology);
+    update_neighbours(topology, rest_position);
     const std::size_t tiles = static_cast<std::size_t>(tile_rows_) * tile_cols_;
     order_.resize(tiles);
     tile_row_.resize(tiles);
@@ -100,7 +101,7 @@ SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_po
     }
 }
 
-void SelfCollision::update_neighbours(const Topology& topology) {
+void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array& rest_position) {
     tested_distance_ = 0.0;  // pairs that shared a spring may meet now: test at the next substep
     candidates_.clear();
     // Compressed rows: count, fill, then sort and drop repeats within each particle's run.
@@ -143,6 +144,35 @@ void SelfCollision::update_neighbours(const Topology& topology) {
         neighbour_.insert(neighbour_.end(), first, std::unique(first, last));
         neighbour_begin_[i + 1] = static_cast<std::uint32_t>(neighbour_.size());
     }
+    // Fold pairs: the ends of a skip-one bending spring or of a bend. Each with half its rest distance, and
+    // on the grid the longest at each offset.
+    std::vector<std::uint64_t> bending;
+    for (const Spring& spring : topology.springs) {
+        if (spring.kind == SpringKind::Bending) bending.push_back(pair_key(spring.a, spring.b));
+    }
+    for (const Bend& b : topology.bends) bending.push_back(pair_key(b.a, b.b));
+    if (!grid_ || far_links_) {  // fold_pair() searches the list
+        std::sort(bending.begin(), bending.end());
+        bending.erase(std::unique(bending.begin(), bending.end()), bending.end());
+    }
+    fold_pairs_.clear();
+    fold_half_rest_.clear();
+    fold_mask_.assign(near_mask_.size(), 0u);
+    longest_fold_half_rest_.fill(0.0);
+    for (const std::uint64_t key : bending) {
+        const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
+        const double half_rest = 0.5 * glm::length(rest_position.get(j) - rest_position.get(i));
+        fold_pairs_.push_back(key);
+        fold_half_rest_.push_back(half_rest);
+        if (!grid_ || far_links_) continue;
+        const int dr = static_cast<int>(j) / cols_ - static_cast<int>(i) / cols_;
+        const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
+        fold_mask_[i] |= 1u << ((dr + 2) * 5 + (dc + 2));
+        fold_mask_[j] |= 1u << ((2 - dr) * 5 + (2 - dc));
+        for (const int k : {(dr + 2) * 5 + (dc + 2), (2 - dr) * 5 + (2 - dc)}) {
+            longest_fold_half_rest_[k] = std::max(longest_fold_half_rest_[k], half_rest);
+        }
+    }
 }
 
 bool SelfCollision::neighbours(std::uint32_t i, std::uint32_t j) const {
@@ -155,8 +185,29 @@ bool SelfCollision::neighbours(std::uint32_t i, std::uint32_t j) const {
     return std::binary_search(begin, end, j);
 }
 
+bool SelfCollision::fold_pair(std::uint32_t i, std::uint32_t j) const {
+    if (grid_ && !far_links_) {
+        const int dr = static_cast<int>(j) / cols_ - static_cast<int>(i) / cols_;
+        const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
+        return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((fold_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
+    }
+    return std::binary_search(fold_pairs_.begin(), fold_pairs_.end(), pair_key(i, j));
+}
+
+double SelfCollision::kept_distance(std::uint32_t i, std::uint32_t j, double d, const DVec3Array& rest_position) const {
+    const double rest = glm::length(rest_position.get(j) - rest_position.get(i));
+    if (fold_pair(i, j)) return std::min(d, 0.5 * rest);
+    return neighbours(i, j) ? 0.0 : std::min(d, rest);
+}
+
 double SelfCollision::contact_distance(const CollisionSettings& settings) const {
     return std::max(static_cast<double>(settings.self_thickness), spacing_);
+}
+
+std::uint32_t SelfCollision::tile_of(std::uint32_t i) const {
+    if (!grid_) return i / kSelfTileParticles;
+    const int r = static_cast<int>(i) / cols_, c = static_cast<int>(i) % cols_;
+    return static_cast<std::uint32_t>((r / kSelfTile) * tile_cols_ + c / kSelfTile);
 }
 
 bool SelfCollision::adjacent_tiles(std::uint32_t a, std::uint32_t b) const {
@@ -260,6 +311,20 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
             }
         }
     }
+    // Fold pairs near their kept distance (a crease sharper than a tile, which the thresholds above do not
+    // see): the tiles of both go to the narrow phase. The others' margins bound the budget below: a
+    // distance shrinks by at most the closing.
+    double fold_margin = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < fold_pairs_.size(); ++k) {
+        const auto i = static_cast<std::uint32_t>(fold_pairs_[k] >> 32), j = static_cast<std::uint32_t>(fold_pairs_[k]);
+        const double kept = std::min(double(d), fold_half_rest_[k]);
+        const double margin = glm::length(position.get(j) - position.get(i)) - kept;
+        if (margin >= std::min(double(skin), 0.5 * kept)) {
+            fold_margin = std::min(fold_margin, margin);
+        } else {  // also NaN
+            active_[tile_of(i)] = active_[tile_of(j)] = 2;
+        }
+    }
     const bool any_active = std::find_if(active_.begin(), active_.end(), [](std::uint8_t a) { return a != 0; }) != active_.end();
     // The budget: how much any two particles may close in before a test could find something new. When no
     // two particles close in by more than b, far boxes come b nearer at most, a diagonal shrinks by at most
@@ -268,7 +333,10 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     // are at least asin(c) >= c radians from being 90 degrees apart. With tiles in the narrow phase, their
     // pairs are listed out to d + skin, so the skin bounds it, and the fold thresholds of the tiles and
     // neighbour pairs not in the narrow phase yet.
-    budget = any_active ? skin : reach - d;
+    budget = std::min(any_active ? double(skin) : double(reach - d), fold_margin);
+    for (std::size_t k = 0; any_active && k < fold_pairs_.size(); ++k) {
+        budget = std::min(budget, 0.5 * std::min(double(d), fold_half_rest_[k]));  // their skin, below
+    }
     for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
         const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
         if (active_[t] != 2) {
@@ -385,7 +453,7 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
             ++skipped_;
             if (uncounted) ++skipped_uncounted_;
             counts.tiles_active = listed_tiles_;
-            resolve(state, settings, rest_position, d, counts);
+            resolve(state, settings, rest_position, counts);
             return counts;
         }
     }
@@ -405,6 +473,14 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     // tile pair once, so each particle pair at most once; resolved in (i, j) order whatever order the tiles
     // came in.
     const float reach2 = static_cast<float>(1.001 * (d + skin) * (d + skin));
+    // A fold pair is listed within its kept distance plus a skin of at most half of it (so that a straight
+    // cloth's fold pairs, 2 s apart, are not listed however thick the cloth).
+    std::array<float, 25> fold_reach2;
+    for (std::size_t k = 0; k < fold_reach2.size(); ++k) {
+        const double kept = std::min(d, longest_fold_half_rest_[k]);
+        const double reach = kept + std::min(skin, 0.5 * kept);
+        fold_reach2[k] = static_cast<float>(1.001 * reach * reach);
+    }
     points_.resize(boxes_.size());
     gathered_.assign(boxes_.size(), 0);
     for (const std::uint64_t key : tile_pairs_) {
@@ -431,16 +507,29 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
                 const int v = __builtin_ctz(close);
                 close &= close - 1;
                 const std::uint32_t i = A.index[u], j = B.index[v];
-                const bool linked = grid_ && !far_links_ ? near_neighbours(i, B.row[v] - A.row[u], B.col[v] - A.col[u])
-                                                         : neighbours(i, j);
-                if (!linked) candidates_.push_back(pair_key(i, j));
+                if (grid_ && !far_links_) {
+                    const int dr = B.row[v] - A.row[u], dc = B.col[v] - A.col[u];
+                    if (near_neighbours(i, dr, dc)) {
+                        if (!fold_pair(i, j)) continue;
+                        const float x = B.x[v] - A.x[u], y = B.y[v] - A.y[u], z = B.z[v] - A.z[u];
+                        if (!(x * x + y * y + z * z < fold_reach2[(dr + 2) * 5 + (dc + 2)])) continue;
+                    }
+                } else if (neighbours(i, j) && !fold_pair(i, j)) {
+                    continue;
+                }
+                candidates_.push_back(pair_key(i, j));
             }
         }
     }
     std::sort(candidates_.begin(), candidates_.end());
+    candidate_kept_.resize(candidates_.size());
+    for (std::size_t k = 0; k < candidates_.size(); ++k) {
+        const std::uint64_t key = candidates_[k];
+        candidate_kept_[k] = kept_distance(static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key), d, rest_position);
+    }
     listed_tiles_ = static_cast<long long>(std::count(gathered_.begin(), gathered_.end(), std::uint8_t{1}));
     counts.tiles_active = listed_tiles_;
-    resolve(state, settings, rest_position, d, counts);
+    resolve(state, settings, rest_position, counts);
     return counts;
 }
 
@@ -448,22 +537,22 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
 // particles outside their motion: any two particles may close in by the sum of the distances each was
 // pushed, which comes off the budget (twice the largest).
 void SelfCollision::resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,
-                            double d, SelfCollisionCounts& counts) {
+                            SelfCollisionCounts& counts) {
     pushed_.resize(particles_, 0.0);
     pushed_list_.clear();
     auto moved = [&](std::uint32_t p, double distance) {
         if (pushed_[p] == 0.0) pushed_list_.push_back(p);
         pushed_[p] += distance;
     };
-    for (const std::uint64_t key : candidates_) {
-        const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
+    for (std::size_t k = 0; k < candidates_.size(); ++k) {
+        const auto i = static_cast<std::uint32_t>(candidates_[k] >> 32), j = static_cast<std::uint32_t>(candidates_[k]);
+        const double least = candidate_kept_[k];
+        const glm::dvec3 v = state.position.get(j) - state.position.get(i);
+        const double length2 = glm::dot(v, v);
+        if (!(length2 < least * least)) continue;
         const double wi = state.inverse_mass[i], wj = state.inverse_mass[j], w = wi + wj;
         if (w == 0.0) continue;
-        const double rest = glm::length(rest_position.get(j) - rest_position.get(i));
-        const double least = std::min(d, rest);
-        const glm::dvec3 v = state.position.get(j) - state.position.get(i);
-        const double length = glm::length(v);
-        if (!(length < least)) continue;
+        const double length = std::sqrt(length2);
         // Coincident particles part along their rest direction (any fixed direction would do).
         const glm::dvec3 normal = length > 1e-12 * least ? v / length
                                                          : glm::normalize(rest_position.get(j) - rest_position.get(i));

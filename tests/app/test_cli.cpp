@@ -171,6 +171,19 @@ TEST_CASE("cli: --json max_strain: clips at hanging's corners stretch the cloth 
     CHECK(clip < 0.7 * point);
 }
 
+TEST_CASE("cli: --json self_intersections: the pile crosses itself without self-collision, never with it") {
+    auto crossings = [](const char* self) {
+        // 0.6 s: the pile has landed and buckled into layers.
+        const RunResult r = run_clothsim({"--headless", "--scene", "pile", "--set", std::string("collision.self=") + self,
+                                          "--duration", "0.6", "--json"});
+        CAPTURE_RUN(r);
+        REQUIRE(r.code == 0);
+        return nlohmann::json::parse(r.out).at("self_intersections").get<long long>();
+    };
+    CHECK(crossings("false") > 100);  // 1936 measured
+    CHECK(crossings("true") == 0);
+}
+
 TEST_CASE("cli: --set changes the scene that is run") {
     const RunResult r = run_clothsim(
         {"--headless", "--set", "cloth.rows=8", "--set", "cloth.cols=6", "--steps", "3", "--json"});

@@ -1,6 +1,7 @@
 // Self-collision (self_collision.hpp): layers of one cloth stay apart and never cross.
 #include "support.hpp"
 
+#include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/self_collision.hpp"
 
@@ -41,79 +42,25 @@ double closest_strangers(const MassSpring& sim, const SelfCollision& springs_of,
     return best;
 }
 
-// Whether segment pq crosses triangle abc (touching counts), in double: the segment's ends lie on opposite
-// sides of the triangle's plane (or on it), and the point where it meets the plane lies inside the triangle
-// (barycentric coordinates, all >= 0). Locating the point, rather than testing the line's orientation
-// against the edges, stays right for a segment nearly in the plane (a flat sheet whose float positions are
-// off the plane by rounding): the point is then on the segment, inside the triangle only if they overlap.
-bool segment_hits_triangle(const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& a, const glm::dvec3& b,
-                           const glm::dvec3& c) {
-    const glm::dvec3 n = glm::cross(b - a, c - a);
-    const double sp = glm::dot(n, p - a), sq = glm::dot(n, q - a);
-    if ((sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) || (sp == 0.0 && sq == 0.0)) return false;
-    const glm::dvec3 x = p + (sp / (sp - sq)) * (q - p);
-    const double la = glm::dot(glm::cross(b - x, c - x), n), lb = glm::dot(glm::cross(c - x, a - x), n),
-                 lc = glm::dot(glm::cross(a - x, b - x), n);
-    return la >= 0.0 && lb >= 0.0 && lc >= 0.0;
-}
-
-// Two triangles that share no vertex intersect when an edge of one crosses the other.
-bool triangles_intersect(const std::array<glm::dvec3, 3>& t, const std::array<glm::dvec3, 3>& u) {
-    for (int e = 0; e < 3; ++e) {
-        if (segment_hits_triangle(t[e], t[(e + 1) % 3], u[0], u[1], u[2])) return true;
-        if (segment_hits_triangle(u[e], u[(e + 1) % 3], t[0], t[1], t[2])) return true;
+// The smallest distance between the two particles of a fold pair (a bending spring's or a bend's ends), as
+// a share of the distance the stage keeps between them (min(d, rest / 2)).
+double fold_share(const MassSpring& sim, const SelfCollision& stage, double d, const DVec3Array& rest) {
+    const DVec3Array& x = sim.state().position;
+    double least = std::numeric_limits<double>::infinity();
+    auto pair = [&](std::uint32_t i, std::uint32_t j) {
+        REQUIRE(stage.fold_pair(i, j));
+        least = std::min(least, glm::length(x.get(j) - x.get(i)) / stage.kept_distance(i, j, d, rest));
+    };
+    for (const Spring& s : sim.topology().springs) {
+        if (s.kind == SpringKind::Bending) pair(s.a, s.b);
     }
-    return false;
-}
-
-// Pairs of triangles with no shared vertex that intersect, at the positions the renderer draws (float),
-// among those whose vertices are at least `apart` rows or columns apart on the grid (0: all).
-std::size_t intersecting_triangles(const MassSpring& sim, int apart = 0) {
-    const int cols = sim.topology().cols;
-    const auto& tris = sim.topology().triangles;
-    const std::size_t m = tris.size();
-    std::vector<std::array<glm::dvec3, 3>> corner(m);
-    std::vector<glm::dvec3> lo(m), hi(m);
-    for (std::size_t k = 0; k < m; ++k) {
-        for (int v = 0; v < 3; ++v) corner[k][v] = glm::dvec3(sim.position(tris[k][v]));
-        lo[k] = glm::min(corner[k][0], glm::min(corner[k][1], corner[k][2]));
-        hi[k] = glm::max(corner[k][0], glm::max(corner[k][1], corner[k][2]));
-    }
-    std::vector<std::size_t> order(m);
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo[a].x < lo[b].x; });
-    std::size_t count = 0;
-    for (std::size_t u = 0; u < m; ++u) {
-        const std::size_t a = order[u];
-        for (std::size_t v = u + 1; v < m && lo[order[v]].x <= hi[a].x; ++v) {
-            const std::size_t b = order[v];
-            if (lo[b].y > hi[a].y || lo[a].y > hi[b].y || lo[b].z > hi[a].z || lo[a].z > hi[b].z) continue;
-            bool shared = false;
-            for (int i = 0; i < 3; ++i) {
-                for (int j = 0; j < 3; ++j) shared = shared || tris[a][i] == tris[b][j];
-            }
-            int separation = 1 << 30;
-            for (int i = 0; i < 3; ++i) {
-                for (int j = 0; j < 3; ++j) {
-                    const int ra = static_cast<int>(tris[a][i]) / cols, ca = static_cast<int>(tris[a][i]) % cols;
-                    const int rb = static_cast<int>(tris[b][j]) / cols, cb = static_cast<int>(tris[b][j]) % cols;
-                    separation = std::min(separation, std::max(std::abs(ra - rb), std::abs(ca - cb)));
-                }
-            }
-            if (!shared && separation >= apart && triangles_intersect(corner[a], corner[b])) ++count;
-        }
-    }
-    return count;
+    for (const Bend& b : sim.topology().bends) pair(b.a, b.b);
+    return least;
 }
 
 }  // namespace
 
-// Layers are triangles three or more rows or columns apart on the grid: those never cross. Triangles one or
-// two apart can, in a crease sharper than the grid resolves (their particles still keep the distance);
-// docs/SELF_COLLISION.md has the counts.
-constexpr int kLayersApart = 3;
-
-TEST_CASE("self-collision: pile and fold keep every pair of strangers half the thickness apart and no layers cross, every step",
+TEST_CASE("self-collision: in pile and fold, strangers keep half the thickness, fold pairs half their kept distance, and no two triangles cross, every step",
           "[self-collision]") {
     for (const char* name : {"pile", "fold"}) {
         Scene scene = load_scene(name);
@@ -121,19 +68,22 @@ TEST_CASE("self-collision: pile and fold keep every pair of strangers half the t
         MassSpring sim = build_simulation(scene);
         const SelfCollision springs_of(sim.topology(), sim.state().position);
         const double d = springs_of.contact_distance(sim.settings().collision);
-        double closest = std::numeric_limits<double>::infinity();
+        const DVec3Array rest = sim.state().position;  // built flat, at rest
+        double closest = std::numeric_limits<double>::infinity(), closest_fold = closest;
         std::size_t crossings = 0;
         for (int step = 0; step < 150; ++step) {  // 2.5 s: falls, folds, settles
             sim.run_steps(1);
             REQUIRE(sim.all_finite());
             closest = std::min(closest, closest_strangers(sim, springs_of, d));
-            crossings += intersecting_triangles(sim, kLayersApart);
+            closest_fold = std::min(closest_fold, fold_share(sim, springs_of, d, rest));
+            crossings += intersecting_triangle_pairs(sim.topology(), sim.positions());
         }
         const long long contacts = sim.profile().self_contacts;
-        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, " << contacts
-                  << " contacts");
+        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, fold pairs down to "
+                  << closest_fold << " of their kept distance, " << contacts << " contacts");
         CHECK(contacts > 1000);  // the layers really met
         CHECK(closest >= 0.5 * d);
+        CHECK(closest_fold >= 0.5);
         CHECK(crossings == 0);
     }
 }
@@ -151,7 +101,7 @@ TEST_CASE("self-collision: without it the same pile passes through itself", "[se
     for (int step = 0; step < 150; ++step) {
         sim.run_steps(1);
         closest = std::min(closest, closest_strangers(sim, springs_of, d));
-        crossings += intersecting_triangles(sim, kLayersApart);
+        crossings += intersecting_triangle_pairs(sim.topology(), sim.positions());
     }
     CHECK(closest < 0.5 * d);
     CHECK(crossings > 0);
@@ -184,7 +134,7 @@ TEST_CASE("self-collision: two approaching strangers are pushed to the distance,
 TEST_CASE("self-collision: between tests the stage resolves every touching pair a test would find, at every "
           "substep of pile and fold", "[self-collision]") {
     // The stage tests the tiles only when the closing since its last test may have spent the skin of its list
-    // (or a fold threshold): at every substep, every pair of strangers closer than min(d, rest distance) that a
+    // (or a fold threshold): at every substep, every pair closer than its kept distance (kept_distance) that a
     // test made there would find must be in the list it resolves. A stage of its own follows the simulation's
     // states substep by substep and is checked against a new stage, which tests at its first substep. The
     // simulation runs without self-collision, so that the particles move between two substeps by their
@@ -225,7 +175,7 @@ TEST_CASE("self-collision: between tests the stage resolves every touching pair 
             std::vector<std::uint64_t> touch;
             for (const std::uint64_t key : fresh.listed_pairs()) {
                 const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
-                const double least = std::min(d, glm::length(rest.get(j) - rest.get(i)));
+                const double least = fresh.kept_distance(i, j, d, rest);
                 if (glm::length(before.position.get(j) - before.position.get(i)) < least) touch.push_back(key);
             }
             touching += static_cast<long long>(touch.size());

@@ -9,10 +9,11 @@
 //    and their sliding is slowed by Coulomb friction (collision.self_friction), both without changing the
 //    momentum.
 //  - Fold pairs, the two ends of a skip-one bending spring or of a bend (2 s apart at rest), are kept
-//    min(d, rest / 2) apart the same way. Without it a crease sharper than the grid turns inside out: the
+//    min(d, rest / 4) apart the same way. Without it a crease sharper than the grid turns inside out: the
 //    particles on either side of the fold line pass each other, and triangles one or two rows apart cross
-//    (docs/SELF_COLLISION.md has the counts). At half its rest distance a fold pair keeps the angle at its
-//    middle particle above 60 degrees. Particles a structural or shear spring joins never collide.
+//    (docs/SELF_COLLISION.md has the counts). At s / 2 a fold pair keeps the angle at its middle particle
+//    above 29 degrees; at s (rest / 2) a cloth could not wrap a bar thinner than its spacing, and `fold`'s
+//    slid off its bar. Particles a structural or shear spring joins never collide.
 //  - Why d >= s keeps layers from crossing: the balls of a flat layer then cover a slab of half-thickness
 //    sqrt(d^2 - s^2 / 2) >= s / sqrt(2) around it, so a particle of another layer that keeps out of every
 //    ball stays on its side, and a triangle of that layer cannot straddle the slab unless an edge of
@@ -73,6 +74,7 @@ inline constexpr int kSelfSkipMax = 64;           // substeps with uncounted mov
 inline constexpr int kSelfSkipLimit = 1024;       // substeps one test covers at most
 inline constexpr double kSelfLookAhead = 8.0;     // far gaps are measured out to d + kSelfLookAhead d
 inline constexpr double kSelfSkin = 0.5;          // a test lists the pairs within d + kSelfSkin d
+inline constexpr double kSelfFoldShare = 0.25;    // a fold pair keeps min(d, this x its rest distance)
 
 // The cloth's particle spacing: its longest structural rest length (0 without structural springs).
 double particle_spacing(const Topology& topology);
@@ -116,7 +118,7 @@ public:
     // Whether i and j are a fold pair: the ends of a bending spring or a bend.
     bool fold_pair(std::uint32_t i, std::uint32_t j) const;
     // The least distance the stage keeps between particles i and j for contact distance d (rest: their
-    // distance in `rest_position`): min(d, rest) for strangers, min(d, rest / 2) for a fold pair, 0 (none)
+    // distance in `rest_position`): min(d, rest) for strangers, min(d, rest / 4) for a fold pair, 0 (none)
     // for other neighbours.
     double kept_distance(std::uint32_t i, std::uint32_t j, double d, const DVec3Array& rest_position) const;
 
@@ -137,9 +139,9 @@ private:
     std::vector<std::uint32_t> near_mask_;  // grid: bit (dr + 2) * 5 + dc + 2 set for a neighbour at (dr, dc)
     bool far_links_ = false;                // grid: some link spans more than two rows or columns
     std::vector<std::uint64_t> fold_pairs_;   // (i << 32 | j), i < j: the fold pairs (sorted off the grid)
-    std::vector<double> fold_half_rest_;      // half the rest distance of each
+    std::vector<double> fold_kept_rest_;      // kSelfFoldShare x the rest distance of each
     std::vector<std::uint32_t> fold_mask_;    // grid: as near_mask_, the fold pairs only
-    std::array<double, 25> longest_fold_half_rest_{};  // grid: the longest half rest distance at (dr, dc)
+    std::array<double, 25> longest_fold_kept_rest_{};  // grid: the longest fold_kept_rest_ at (dr, dc)
     bool near_neighbours(std::uint32_t i, int dr, int dc) const {
         return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((near_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
     }

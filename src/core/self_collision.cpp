@@ -144,8 +144,8 @@ void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array
         neighbour_.insert(neighbour_.end(), first, std::unique(first, last));
         neighbour_begin_[i + 1] = static_cast<std::uint32_t>(neighbour_.size());
     }
-    // Fold pairs: the ends of a skip-one bending spring or of a bend. Each with half its rest distance, and
-    // on the grid the longest at each offset.
+    // Fold pairs: the ends of a skip-one bending spring or of a bend. Each with kSelfFoldShare of its rest
+    // distance, and on the grid the longest at each offset.
     std::vector<std::uint64_t> bending;
     for (const Spring& spring : topology.springs) {
         if (spring.kind == SpringKind::Bending) bending.push_back(pair_key(spring.a, spring.b));
@@ -156,21 +156,21 @@ void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array
         bending.erase(std::unique(bending.begin(), bending.end()), bending.end());
     }
     fold_pairs_.clear();
-    fold_half_rest_.clear();
+    fold_kept_rest_.clear();
     fold_mask_.assign(near_mask_.size(), 0u);
-    longest_fold_half_rest_.fill(0.0);
+    longest_fold_kept_rest_.fill(0.0);
     for (const std::uint64_t key : bending) {
         const auto i = static_cast<std::uint32_t>(key >> 32), j = static_cast<std::uint32_t>(key);
-        const double half_rest = 0.5 * glm::length(rest_position.get(j) - rest_position.get(i));
+        const double kept_rest = kSelfFoldShare * glm::length(rest_position.get(j) - rest_position.get(i));
         fold_pairs_.push_back(key);
-        fold_half_rest_.push_back(half_rest);
+        fold_kept_rest_.push_back(kept_rest);
         if (!grid_ || far_links_) continue;
         const int dr = static_cast<int>(j) / cols_ - static_cast<int>(i) / cols_;
         const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
         fold_mask_[i] |= 1u << ((dr + 2) * 5 + (dc + 2));
         fold_mask_[j] |= 1u << ((2 - dr) * 5 + (2 - dc));
         for (const int k : {(dr + 2) * 5 + (dc + 2), (2 - dr) * 5 + (2 - dc)}) {
-            longest_fold_half_rest_[k] = std::max(longest_fold_half_rest_[k], half_rest);
+            longest_fold_kept_rest_[k] = std::max(longest_fold_kept_rest_[k], kept_rest);
         }
     }
 }
@@ -196,7 +196,7 @@ bool SelfCollision::fold_pair(std::uint32_t i, std::uint32_t j) const {
 
 double SelfCollision::kept_distance(std::uint32_t i, std::uint32_t j, double d, const DVec3Array& rest_position) const {
     const double rest = glm::length(rest_position.get(j) - rest_position.get(i));
-    if (fold_pair(i, j)) return std::min(d, 0.5 * rest);
+    if (fold_pair(i, j)) return std::min(d, kSelfFoldShare * rest);
     return neighbours(i, j) ? 0.0 : std::min(d, rest);
 }
 
@@ -317,7 +317,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     double fold_margin = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < fold_pairs_.size(); ++k) {
         const auto i = static_cast<std::uint32_t>(fold_pairs_[k] >> 32), j = static_cast<std::uint32_t>(fold_pairs_[k]);
-        const double kept = std::min(double(d), fold_half_rest_[k]);
+        const double kept = std::min(double(d), fold_kept_rest_[k]);
         const double margin = glm::length(position.get(j) - position.get(i)) - kept;
         if (margin >= std::min(double(skin), 0.5 * kept)) {
             fold_margin = std::min(fold_margin, margin);
@@ -335,7 +335,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     // neighbour pairs not in the narrow phase yet.
     budget = std::min(any_active ? double(skin) : double(reach - d), fold_margin);
     for (std::size_t k = 0; any_active && k < fold_pairs_.size(); ++k) {
-        budget = std::min(budget, 0.5 * std::min(double(d), fold_half_rest_[k]));  // their skin, below
+        budget = std::min(budget, 0.5 * std::min(double(d), fold_kept_rest_[k]));  // their skin, below
     }
     for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
         const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
@@ -477,7 +477,7 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     // cloth's fold pairs, 2 s apart, are not listed however thick the cloth).
     std::array<float, 25> fold_reach2;
     for (std::size_t k = 0; k < fold_reach2.size(); ++k) {
-        const double kept = std::min(d, longest_fold_half_rest_[k]);
+        const double kept = std::min(d, longest_fold_kept_rest_[k]);
         const double reach = kept + std::min(skin, 0.5 * kept);
         fold_reach2[k] = static_cast<float>(1.001 * reach * reach);
     }

@@ -66,12 +66,12 @@ Coefficients coefficients(double damping, double h) {
 // What every update reads: the float forces, float inverse masses, the pins and gravity.
 struct Inputs {
     const Vec3Array* force;
-    const std::vector<float>* inverse_mass;
+    const AlignedVector<float>* inverse_mass;
     const std::vector<std::uint8_t>* pinned;
     glm::vec3 gravity;
 };
 
-const std::vector<float>& axis(const Vec3Array& v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
+const AlignedVector<float>& axis(const Vec3Array& v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
 float component(glm::vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
 
 // Two-sum (Knuth): s + e == a + b exactly, s = fl(a + b).

@@ -3,6 +3,7 @@
 //  - State changes every step and is laid out as structure of arrays for the hot loops.
 #pragma once
 
+#include "clothsim/aligned_allocator.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/spring.hpp"
 
@@ -23,7 +24,7 @@ namespace clothsim {
 template <class T>
 struct BasicVec3Array {
     using Vec = glm::vec<3, T>;
-    std::vector<T> x, y, z;
+    AlignedVector<T> x, y, z;  // each starts on a cache line
 
     std::size_t size() const { return x.size(); }
     void resize(std::size_t n, T value = T(0)) {
@@ -109,7 +110,7 @@ struct State {
     DVec3Array motion;
     // Parameters, not accumulators: float is exact enough and halves what the integration loops read.
     std::vector<float> mass;          // kg (kept for pinned particles too, for energy and momentum)
-    std::vector<float> inverse_mass;  // 1/kg, 0 for pinned particles
+    AlignedVector<float> inverse_mass;  // 1/kg, 0 for pinned particles (read with the rows)
     std::vector<std::uint8_t> pinned;  // 0 free, else kPinned or kAbsent: either never moves
     double time = 0.0;     // s
     double substep = 0.0;  // s: the substep `motion` belongs to

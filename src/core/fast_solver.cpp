@@ -233,24 +233,47 @@ MotionBounds reduce_lanes(const double* lanes) {
 
 __attribute__((target("avx512f,avx512vl,avx2,fma"))) void widen_avx512(const double* m, int n, double* lo,
                                                                        double* hi) {
-    // maskz with all lanes: the unmasked forms trip GCC 12's -Wuninitialized in its header.
-    __m512d l = _mm512_load_pd(lo), h = _mm512_load_pd(hi);
+    // maskz with all lanes: the unmasked forms trip GCC 12's -Wuninitialized in its header. Four running
+    // bounds, joined at the end: one would make every vector wait for the last one's min and max.
+    __m512d l0 = _mm512_load_pd(lo), h0 = _mm512_load_pd(hi);
+    __m512d l1 = l0, l2 = l0, l3 = l0, h1 = h0, h2 = h0, h3 = h0;
     int c = 0;
+    for (; c + 32 <= n; c += 32) {
+        const __m512d a = _mm512_loadu_pd(m + c), b = _mm512_loadu_pd(m + c + 8);
+        const __m512d d = _mm512_loadu_pd(m + c + 16), e = _mm512_loadu_pd(m + c + 24);
+        l0 = _mm512_maskz_min_pd(0xFF, l0, a), h0 = _mm512_maskz_max_pd(0xFF, h0, a);
+        l1 = _mm512_maskz_min_pd(0xFF, l1, b), h1 = _mm512_maskz_max_pd(0xFF, h1, b);
+        l2 = _mm512_maskz_min_pd(0xFF, l2, d), h2 = _mm512_maskz_max_pd(0xFF, h2, d);
+        l3 = _mm512_maskz_min_pd(0xFF, l3, e), h3 = _mm512_maskz_max_pd(0xFF, h3, e);
+    }
     for (; c + 8 <= n; c += 8) {
         const __m512d v = _mm512_loadu_pd(m + c);
-        l = _mm512_maskz_min_pd(0xFF, l, v), h = _mm512_maskz_max_pd(0xFF, h, v);
+        l0 = _mm512_maskz_min_pd(0xFF, l0, v), h0 = _mm512_maskz_max_pd(0xFF, h0, v);
     }
-    _mm512_store_pd(lo, l), _mm512_store_pd(hi, h);
+    l0 = _mm512_maskz_min_pd(0xFF, _mm512_maskz_min_pd(0xFF, l0, l1), _mm512_maskz_min_pd(0xFF, l2, l3));
+    h0 = _mm512_maskz_max_pd(0xFF, _mm512_maskz_max_pd(0xFF, h0, h1), _mm512_maskz_max_pd(0xFF, h2, h3));
+    _mm512_store_pd(lo, l0), _mm512_store_pd(hi, h0);
     widen_tail(m, c, n, lo, hi);
 }
 __attribute__((target("avx2,fma"))) void widen_avx2(const double* m, int n, double* lo, double* hi) {
+    // Lanes 0-3 and 4-7, each with two running bounds (columns c and c + 8), joined at the end.
     __m256d l0 = _mm256_load_pd(lo), l1 = _mm256_load_pd(lo + 4), h0 = _mm256_load_pd(hi), h1 = _mm256_load_pd(hi + 4);
+    __m256d l2 = l0, l3 = l1, h2 = h0, h3 = h1;
     int c = 0;
+    for (; c + 16 <= n; c += 16) {
+        const __m256d a = _mm256_loadu_pd(m + c), b = _mm256_loadu_pd(m + c + 4);
+        const __m256d d = _mm256_loadu_pd(m + c + 8), e = _mm256_loadu_pd(m + c + 12);
+        l0 = _mm256_min_pd(l0, a), h0 = _mm256_max_pd(h0, a);
+        l1 = _mm256_min_pd(l1, b), h1 = _mm256_max_pd(h1, b);
+        l2 = _mm256_min_pd(l2, d), h2 = _mm256_max_pd(h2, d);
+        l3 = _mm256_min_pd(l3, e), h3 = _mm256_max_pd(h3, e);
+    }
     for (; c + 8 <= n; c += 8) {
         const __m256d a = _mm256_loadu_pd(m + c), b = _mm256_loadu_pd(m + c + 4);
         l0 = _mm256_min_pd(l0, a), h0 = _mm256_max_pd(h0, a);
         l1 = _mm256_min_pd(l1, b), h1 = _mm256_max_pd(h1, b);
     }
+    l0 = _mm256_min_pd(l0, l2), l1 = _mm256_min_pd(l1, l3), h0 = _mm256_max_pd(h0, h2), h1 = _mm256_max_pd(h1, h3);
     _mm256_store_pd(lo, l0), _mm256_store_pd(lo + 4, l1), _mm256_store_pd(hi, h0), _mm256_store_pd(hi + 4, h1);
     widen_tail(m, c, n, lo, hi);
 }

@@ -224,9 +224,7 @@ int run_skipping(const SkippingOptions& o) {
             for (const auto& [phase, start] : {std::pair{"falling", 0.0}, std::pair{"draped", 2.5}}) {
                 MassSpring a = build_simulation(off), b = build_simulation(on);
                 a.run_steps(std::llround(start / on.settings.integration.dt));
-                // At least one step: the stage is built at its first substep, once per simulation, and the windows
-            // restart from this state, so none of them pays for building it.
-            b.run_steps(std::max(1LL, std::llround(start / on.settings.integration.dt)));
+                b.run_steps(std::llround(start / on.settings.integration.dt));
                 if (!a.all_finite() || !b.all_finite()) throw std::runtime_error("the drape became non-finite");
                 const MassSpring a0 = a, b0 = b;
                 const int frames = kWindowFrames;

@@ -1,7 +1,8 @@
 // An allocator whose blocks start on a cache line (64 bytes), for the arrays the hot loops stream through.
-// With malloc's 16-byte alignment three of every four rows of a grid started mid-line, so every 512-bit
-// load of a row split two lines, and which arrays did depended on where the heap put them: two identical
-// simulations differed by 3% in speed (docs/PERFORMANCE.md).
+// With malloc's 16-byte alignment an array could start mid-line; a grid row of 64 or 128 columns is a
+// whole number of lines, so then every row did, and every 512-bit load of a row split two lines. Which
+// arrays did depended on where the heap put them: two identical simulations differed by 3% in speed
+// (docs/PERFORMANCE.md).
 #pragma once
 
 #include <cstddef>

@@ -13,7 +13,8 @@
 
 namespace clothsim {
 
-// Whether segment pq meets triangle abc (touching counts), in double: the ends lie on opposite sides of the
+// Whether segment pq meets triangle abc (touching counts), in double precision (signs of plain double
+// products, not an exact predicate; a degenerate, zero-area triangle is never met): the ends lie on opposite sides of the
 // triangle's plane (or on it), and the point where the segment meets the plane lies inside the triangle
 // (barycentric signs, all >= 0). Locating the point, rather than testing the line's orientation against
 // the edges, stays right for a segment nearly in the plane (a flat sheet whose float positions are off the

@@ -12,7 +12,7 @@
 //    min(d, rest / 4) apart the same way. Without it a crease sharper than the grid turns inside out: the
 //    particles on either side of the fold line pass each other, and triangles one or two rows apart cross
 //    (docs/SELF_COLLISION.md has the counts). At s / 2 a fold pair keeps the angle at its middle particle
-//    above 29 degrees; at s (rest / 2) a cloth could not wrap a bar thinner than its spacing, and `fold`'s
+//    above about 29 degrees; at s (rest / 2) a cloth could not wrap a bar thinner than its spacing, and `fold`'s
 //    slid off its bar. Particles a structural or shear spring joins never collide.
 //  - Why d >= s keeps layers from crossing: the balls of a flat layer then cover a slab of half-thickness
 //    sqrt(d^2 - s^2 / 2) >= s / sqrt(2) around it, so a particle of another layer that keeps out of every
@@ -109,8 +109,8 @@ public:
     // Something moved particles outside a step (an edit, a restart): the next substep tests afresh.
     void invalidate() { tested_distance_ = 0.0; }
 
-    // The particle pairs (i << 32 | j, i < j) the last substep resolved from: every pair within d + skin at
-    // the last test.
+    // The particle pairs (i << 32 | j, i < j) the last substep resolved from: every pair within its reach
+    // (kept distance + skin) at the last test.
     const std::vector<std::uint64_t>& listed_pairs() const { return candidates_; }
 
     // Whether particles i and j share a spring or a bend.

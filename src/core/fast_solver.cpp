@@ -208,7 +208,8 @@ void reset_lanes(double* lanes) {
 }
 
 // As MINPD and MAXPD (which return their second operand when either is NaN), a NaN value takes its lane's
-// bound until the lane's next value; the bounds of a cloth that is not finite are the guard's concern.
+// bound until the lane's (or, in the vector forms, its running chain's) next value, and may be kept or
+// dropped where the chains are joined; the bounds of a cloth that is not finite are the guard's concern.
 void widen_tail(const double* m, int c, int n, double* lo, double* hi) {
     for (; c < n; ++c) {
         lo[c & 7] = lo[c & 7] < m[c] ? lo[c & 7] : m[c];

@@ -533,7 +533,7 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     return counts;
 }
 
-// The listed pairs closer than min(d, their rest distance), pushed apart in (i, j) order. The pushes move
+// The listed pairs closer than their kept distance, pushed apart in (i, j) order. The pushes move
 // particles outside their motion: any two particles may close in by the sum of the distances each was
 // pushed, which comes off the budget (twice the largest).
 void SelfCollision::resolve(State& state, const CollisionSettings& settings, const DVec3Array& rest_position,

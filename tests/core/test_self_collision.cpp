@@ -1,9 +1,11 @@
 // Self-collision (self_collision.hpp): layers of one cloth stay apart and never cross.
+#include "per_spring_scenes.hpp"
 #include "support.hpp"
 
 #include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/self_collision.hpp"
+#include "clothsim/tearing.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -50,6 +52,7 @@ double fold_share(const MassSpring& sim, const SelfCollision& stage, double d, c
     double least = std::numeric_limits<double>::infinity();
     auto pair = [&](std::uint32_t i, std::uint32_t j) {
         REQUIRE(stage.fold_pair(i, j));
+        REQUIRE(stage.fold_pair(j, i));
         least = std::min(least, glm::length(x.get(j) - x.get(i)) / stage.kept_distance(i, j, d, rest));
     };
     for (const Spring& s : sim.topology().springs) {
@@ -115,6 +118,52 @@ TEST_CASE("self-collision: without it the same pile passes through itself", "[se
     }
     CHECK(closest < 0.5 * d);
     CHECK(crossings > 0);
+}
+
+TEST_CASE("self-collision: fold pairs are the ends of bending springs and bends, both ways, on the grid, off it "
+          "and after a tear", "[self-collision]") {
+    for (const bool material : {false, true}) {  // skip-one bending springs, or bends
+        Scene scene = material ? load_scene("falling") : per_spring_scene("falling");
+        scene.cloth.rows = scene.cloth.cols = 8;
+        MassSpring sim = build_simulation(scene);
+        const DVec3Array& rest = sim.state().position;
+        Topology topology = sim.topology();
+        REQUIRE(topology.bends.empty() == !material);
+        auto at = [&](int r, int c) { return static_cast<std::uint32_t>(topology.index(r, c)); };
+        Topology listed = topology;  // the same links with no grid: the stage searches its lists
+        listed.rows = listed.cols = 0;
+        for (const Topology* t : {&topology, &listed}) {
+            const SelfCollision stage(*t, rest);
+            const double d = stage.contact_distance(sim.settings().collision), s = stage.spacing();
+            INFO((material ? "bends" : "bending springs") << (t == &listed ? ", off the grid" : ", on the grid"));
+            for (const auto& [a, b] : {std::pair{at(3, 2), at(3, 4)}, std::pair{at(2, 5), at(4, 5)}}) {
+                CHECK(stage.fold_pair(a, b));
+                CHECK(stage.fold_pair(b, a));
+                CHECK(stage.kept_distance(a, b, d, rest) == Approx(0.5 * s).epsilon(1e-6));  // rest / 4 = s / 2 (s: a float rest length)
+                CHECK(stage.kept_distance(b, a, d, rest) == Approx(0.5 * s).epsilon(1e-6));
+            }
+            // A structural and a shear neighbour: never kept apart. A stranger: min(d, rest) = d.
+            CHECK_FALSE(stage.fold_pair(at(3, 2), at(3, 3)));
+            CHECK(stage.kept_distance(at(3, 2), at(3, 3), d, rest) == 0.0);
+            CHECK(stage.kept_distance(at(3, 2), at(4, 3), d, rest) == 0.0);
+            CHECK_FALSE(stage.fold_pair(at(3, 2), at(4, 4)));
+            CHECK(stage.kept_distance(at(3, 2), at(4, 4), d, rest) == Approx(d).epsilon(1e-9));
+        }
+        // Torn between (3, 3) and (3, 4): the fold pair across it, (3, 2)-(3, 4), is no longer linked and is a
+        // stranger kept d apart; the one beside it, (2, 2)-(2, 4), is still a fold pair.
+        SelfCollision stage(topology, rest);
+        const std::size_t removed = break_springs(topology, [&](const Spring& spring) {
+            return spring.kind == SpringKind::Structural && std::min(spring.a, spring.b) == at(3, 3) &&
+                   std::max(spring.a, spring.b) == at(3, 4);
+        });
+        REQUIRE(removed >= 2);
+        stage.update_neighbours(topology, rest);
+        const double d = stage.contact_distance(sim.settings().collision);
+        CHECK_FALSE(stage.fold_pair(at(3, 2), at(3, 4)));
+        CHECK_FALSE(stage.neighbours(at(3, 2), at(3, 4)));
+        CHECK(stage.kept_distance(at(3, 2), at(3, 4), d, rest) == Approx(d).epsilon(1e-9));
+        CHECK(stage.fold_pair(at(2, 2), at(2, 4)));
+    }
 }
 
 TEST_CASE("self-collision: two approaching strangers are pushed to the distance, their approach removed, momentum kept",

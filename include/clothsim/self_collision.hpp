@@ -142,8 +142,10 @@ private:
     std::vector<double> fold_kept_rest_;      // kSelfFoldShare x the rest distance of each
     std::vector<std::uint32_t> fold_mask_;    // grid: as near_mask_, the fold pairs only
     std::array<double, 25> longest_fold_kept_rest_{};  // grid: the longest fold_kept_rest_ at (dr, dc)
-    bool near_neighbours(std::uint32_t i, int dr, int dc) const {
-        return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((near_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
+    bool near_neighbours(std::uint32_t i, int dr, int dc) const { return near_bit(near_mask_, i, dr, dc); }
+    bool near_fold_pair(std::uint32_t i, int dr, int dc) const { return near_bit(fold_mask_, i, dr, dc); }
+    static bool near_bit(const std::vector<std::uint32_t>& mask, std::uint32_t i, int dr, int dc) {
+        return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((mask[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
     }
     std::vector<int> tile_row_, tile_col_;  // each tile's place in the grid of tiles
     std::vector<std::array<std::uint32_t, 4>> corner_;  // grid: each tile's corner particles (00, 0c, r0, rc)

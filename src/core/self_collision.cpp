@@ -30,6 +30,10 @@ float box_gap(const Box& a, const Box& b) {
     return glm::length(gap);
 }
 
+// The skin of a fold pair kept `kept` apart: at most half its kept distance, so that a straight cloth's fold
+// pairs (2 s apart) are not listed however thick the cloth.
+double fold_skin(double kept, double skin) { return std::min(skin, 0.5 * kept); }
+
 // Whether boxes a and b come within `reach` of each other (per axis).
 bool within(const Box& a, const Box& b, float reach) {
     return a.lo.x <= b.hi.x + reach && b.lo.x <= a.hi.x + reach && a.lo.y <= b.hi.y + reach &&
@@ -189,7 +193,7 @@ bool SelfCollision::fold_pair(std::uint32_t i, std::uint32_t j) const {
     if (grid_ && !far_links_) {
         const int dr = static_cast<int>(j) / cols_ - static_cast<int>(i) / cols_;
         const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
-        return std::abs(dr) <= 2 && std::abs(dc) <= 2 && ((fold_mask_[i] >> ((dr + 2) * 5 + (dc + 2))) & 1u) != 0;
+        return near_fold_pair(i, dr, dc);
     }
     return std::binary_search(fold_pairs_.begin(), fold_pairs_.end(), pair_key(i, j));
 }
@@ -315,11 +319,13 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     // see): the tiles of both go to the narrow phase. The others' margins bound the budget below: a
     // distance shrinks by at most the closing.
     double fold_margin = std::numeric_limits<double>::infinity();
+    double least_fold_skin = std::numeric_limits<double>::infinity();  // bounds the budget when listing
     for (std::size_t k = 0; k < fold_pairs_.size(); ++k) {
         const auto i = static_cast<std::uint32_t>(fold_pairs_[k] >> 32), j = static_cast<std::uint32_t>(fold_pairs_[k]);
         const double kept = std::min(double(d), fold_kept_rest_[k]);
         const double margin = glm::length(position.get(j) - position.get(i)) - kept;
-        if (margin >= std::min(double(skin), 0.5 * kept)) {
+        least_fold_skin = std::min(least_fold_skin, fold_skin(kept, skin));
+        if (margin >= fold_skin(kept, skin)) {
             fold_margin = std::min(fold_margin, margin);
         } else {  // also NaN
             active_[tile_of(i)] = active_[tile_of(j)] = 2;
@@ -333,10 +339,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     // are at least asin(c) >= c radians from being 90 degrees apart. With tiles in the narrow phase, their
     // pairs are listed out to d + skin, so the skin bounds it, and the fold thresholds of the tiles and
     // neighbour pairs not in the narrow phase yet.
-    budget = std::min(any_active ? double(skin) : double(reach - d), fold_margin);
-    for (std::size_t k = 0; any_active && k < fold_pairs_.size(); ++k) {
-        budget = std::min(budget, 0.5 * std::min(double(d), fold_kept_rest_[k]));  // their skin, below
-    }
+    budget = std::min(any_active ? std::min(double(skin), least_fold_skin) : double(reach - d), fold_margin);
     for (std::uint32_t t = 0; grid_ && t < tiles; ++t) {
         const float* rest = tile_rest_.data() + static_cast<std::size_t>(t) * 5;
         if (active_[t] != 2) {
@@ -473,12 +476,11 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
     // tile pair once, so each particle pair at most once; resolved in (i, j) order whatever order the tiles
     // came in.
     const float reach2 = static_cast<float>(1.001 * (d + skin) * (d + skin));
-    // A fold pair is listed within its kept distance plus a skin of at most half of it (so that a straight
-    // cloth's fold pairs, 2 s apart, are not listed however thick the cloth).
+    // A fold pair is listed within its kept distance plus its skin (fold_skin).
     std::array<float, 25> fold_reach2;
     for (std::size_t k = 0; k < fold_reach2.size(); ++k) {
         const double kept = std::min(d, longest_fold_kept_rest_[k]);
-        const double reach = kept + std::min(skin, 0.5 * kept);
+        const double reach = kept + fold_skin(kept, skin);
         fold_reach2[k] = static_cast<float>(1.001 * reach * reach);
     }
     points_.resize(boxes_.size());
@@ -510,7 +512,7 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
                 if (grid_ && !far_links_) {
                     const int dr = B.row[v] - A.row[u], dc = B.col[v] - A.col[u];
                     if (near_neighbours(i, dr, dc)) {
-                        if (!fold_pair(i, j)) continue;
+                        if (!near_fold_pair(i, dr, dc)) continue;
                         const float x = B.x[v] - A.x[u], y = B.y[v] - A.y[u], z = B.z[v] - A.z[u];
                         if (!(x * x + y * y + z * z < fold_reach2[(dr + 2) * 5 + (dc + 2)])) continue;
                     }

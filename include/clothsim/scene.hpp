@@ -55,6 +55,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field);
 
 // ---- Names of the enumerations, as written in files. ----
 std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
+std::span<const std::string_view> clip_hold_names();    // rigid, soft
 std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook
 std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd
@@ -102,6 +103,17 @@ std::string describe_pin_radius();
 // ---- Building. ----
 // Pinned particle indices (row-major) for a cloth; throws SceneError for a pin outside the grid.
 std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins);
+// The particles of soft clips (pins.clip = "soft"), each with its clip's radius and its weight
+// (1 - (d / R)^2)^2 at distance d from the clip's particle at rest: 1 there, falling smoothly to 0 at the rim.
+// Point pins stay rigid (pinned_particles). Empty for rigid clips.
+// A soft clip's stiffness per unit area, kappa = kClipHoldFactor E / R^2 (cloth_builder.cpp).
+inline constexpr double kClipHoldFactor = 4.0;
+struct ClipWeight {
+    std::size_t particle;
+    double weight;
+    double radius;  // m
+};
+std::vector<ClipWeight> soft_clip_weights(const ClothSettings& cloth, const PinSpec& pins);
 // The particles, springs and triangles of the grid, and the ready-to-step simulation. Throws SceneError.
 MassSpring build_simulation(const Scene& scene);
 

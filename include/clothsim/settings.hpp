@@ -16,6 +16,10 @@ namespace clothsim {
 
 // Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
+// How a clip (a pin with a radius) holds: Rigid pins every particle within the radius; Soft holds each to
+// where it is at rest by a zero-length spring whose stiffness fades to 0 at the rim (docs/MATERIAL.md,
+// "Clips"), so the strain at the clip converges as the grid is refined.
+enum class ClipHold { Rigid, Soft };
 
 // The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,
 // projective).
@@ -134,6 +138,7 @@ struct PinSpec {
     PinPreset preset = PinPreset::TopCorners;
     std::vector<PinClip> particles;  // in addition to the preset
     float preset_radius = 0.0f;      // m: each pin of the preset is a clip of this radius (0 = point pins)
+    ClipHold clip = ClipHold::Rigid;  // how every clip holds (point pins are always rigid)
     bool operator==(const PinSpec&) const = default;
 };
 

@@ -16,6 +16,7 @@ enum class Stage {
     Springs,     // spring forces (textbook solver and velocity integrators)
     Wind,        // wind forces
     Contact,     // penalty contact forces (colliders.contact = penalty; penalty_contact.hpp)
+    Clips,       // soft clips' holding forces (pins.clip = "soft")
     Fast,        // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
     BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth

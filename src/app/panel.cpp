@@ -105,12 +105,14 @@ bool float_widget(const std::string& label, const FieldInfo& f, float* v) {
 }
 
 // The pins: a preset picked in a combo (which drops the particles pinned by hand and keeps the preset's clip
-// radius). The preview shows the clip radius and how many pins were added by hand ("top-corners, clip 0.03 m + 2").
+// radius), and below the presets whether clips hold softly. The preview shows the clip radius and how many pins
+// were added by hand ("top-corners, soft clip 0.03 m + 2").
 bool pin_combo(const std::string& label, PinSpec* v) {
     const int preset = static_cast<int>(v->preset);
     const auto names = pin_preset_names();
     char clip[48] = "";
-    if (v->preset_radius > 0.0f) std::snprintf(clip, sizeof clip, ", clip %.3g m", v->preset_radius);
+    const char* kind = v->clip == ClipHold::Soft ? "soft clip" : "clip";
+    if (v->preset_radius > 0.0f) std::snprintf(clip, sizeof clip, ", %s %.3g m", kind, v->preset_radius);
     const std::string preview = std::string(names[preset]) + clip +
                                 (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
     bool edited = false;
@@ -121,6 +123,16 @@ bool pin_combo(const std::string& label, PinSpec* v) {
                 v->particles.clear();
                 edited = true;
             }
+        }
+        ImGui::Separator();
+        // Only clips (pins with a radius) can be soft; point pins stay rigid.
+        bool soft = v->clip == ClipHold::Soft;
+        if (ImGui::Checkbox("soft clips", &soft)) {
+            v->clip = soft ? ClipHold::Soft : ClipHold::Rigid;
+            edited = true;
+        }
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("Hold each clip's particles by springs that fade to 0 at its rim instead of pinning them");
         }
         ImGui::EndCombo();
     }
@@ -533,7 +545,8 @@ void stability_lines(AppState& app) {
     if (limit.bound != StabilityBound::Springs) {
         // The springs are implicit: a plane wave of them sets no limit (stability.hpp).
         ImGui::Text("critical substep %.4g ms (%s)", 1e3 * limit.critical_substep,
-                    limit.bound == StabilityBound::Damping ? "damping: c h < 2" : "penalty contact");
+                    limit.bound == StabilityBound::Damping ? "damping: c h < 2"
+                    : limit.bound == StabilityBound::Clips ? "soft clips" : "penalty contact");
     } else {
         ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
                     1e3 * limit.plane_wave_substep);

@@ -91,9 +91,10 @@ Topology grid_topology(const ShapeMask& shape, const DVec3Array& position, bool 
     return t;
 }
 
-}  // namespace
-
-std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins) {
+// Every particle a pin of `pins` holds: visit(index, radius, distance), the distance at rest from the pin's
+// own particle (0 and 0 for a point pin).
+template <class Visit>
+void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& visit) {
     const int rows = cloth.rows, cols = cloth.cols;
     // A clip holds the particles within its radius at rest. Rest positions are build_simulation's:
     // origin + c du u + r dv v, u and v normalised, so particles dc columns and dr rows apart lie
@@ -106,14 +107,15 @@ std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinS
     // A particle dc columns away is at least |dc| du sin(angle) from the clip's centre (its distance to the
     // line through the centre along v), so only a box of rows and columns needs looking at.
     const double sin_uv = std::sqrt(std::max(0.0, 1.0 - cos_uv * cos_uv));
-    std::vector<std::size_t> out;
     auto pin = [&](int r, int c, double radius) {
         if (r < 0 || r >= rows || c < 0 || c >= cols) {
             throw SceneError("pins: particle [" + std::to_string(r) + ", " + std::to_string(c) + "] is outside the " +
                              std::to_string(rows) + " x " + std::to_string(cols) + " grid");
         }
-        out.push_back(static_cast<std::size_t>(r) * cols + c);
-        if (!(radius > 0.0)) return;  // a point pin
+        if (!(radius > 0.0)) {  // a point pin
+            visit(static_cast<std::size_t>(r) * cols + c, 0.0, 0.0);
+            return;
+        }
         // A particle on the clip's rim counts: the radius is widened by 1e-6 of itself, far below any grid
         // spacing, so a radius written as exactly k spacings (0.02 m at 0.01 m spacing) is not lost to rounding.
         const double reach = radius * (1.0 + 1e-6);
@@ -125,8 +127,9 @@ std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinS
         for (int rr = std::max(0, r - dr_max); rr <= std::min(rows - 1, r + dr_max); ++rr) {
             for (int cc = std::max(0, c - dc_max); cc <= std::min(cols - 1, c + dc_max); ++cc) {
                 const double a = (cc - c) * du, b = (rr - r) * dv;
-                if (a * a + b * b + 2.0 * a * b * cos_uv <= reach * reach) {
-                    out.push_back(static_cast<std::size_t>(rr) * cols + cc);
+                const double distance2 = a * a + b * b + 2.0 * a * b * cos_uv;
+                if (distance2 <= reach * reach) {
+                    visit(static_cast<std::size_t>(rr) * cols + cc, radius, std::sqrt(std::max(0.0, distance2)));
                 }
             }
         }
@@ -142,8 +145,34 @@ std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinS
         case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0, clip); break;
     }
     for (const PinClip& p : pins.particles) pin(p.row, p.col, p.radius);
+}
+
+}  // namespace
+
+std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins) {
+    std::vector<std::size_t> out;
+    for_each_pinned(cloth, pins, [&](std::size_t i, double radius, double) {
+        if (radius == 0.0 || pins.clip == ClipHold::Rigid) out.push_back(i);
+    });
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+std::vector<ClipWeight> soft_clip_weights(const ClothSettings& cloth, const PinSpec& pins) {
+    std::vector<ClipWeight> out;
+    if (pins.clip != ClipHold::Soft) return out;
+    for_each_pinned(cloth, pins, [&](std::size_t i, double radius, double distance) {
+        const double t = radius > 0.0 ? distance / radius : 1.0;
+        if (t >= 1.0 - 1e-6) return;  // a point pin (rigid), or a particle on the rim: weight 0
+        out.push_back({i, (1.0 - t * t) * (1.0 - t * t), radius});
+    });
+    // A particle in several clips: the one that holds it hardest.
+    std::sort(out.begin(), out.end(), [](const ClipWeight& a, const ClipWeight& b) {
+        return a.particle != b.particle ? a.particle < b.particle : a.weight / (a.radius * a.radius) > b.weight / (b.radius * b.radius);
+    });
+    out.erase(std::unique(out.begin(), out.end(), [](const ClipWeight& a, const ClipWeight& b) { return a.particle == b.particle; }),
+              out.end());
     return out;
 }
 
@@ -199,6 +228,24 @@ MassSpring build_simulation(const Scene& scene) {
     // The springs' k from the material here too, for a scene changed in code after it was loaded.
     Scene derived = scene;
     derive_springs(derived);
+    // Soft clips: each particle held with k = kappa A w, its rest area A (a quarter of each cell it borders)
+    // and its weight w; kappa = kClipHoldFactor E / R^2 per unit area, E the structural springs' stiffness.
+    // A whole disc then holds with kappa R^2 (pi / 3) = 4.2 E in all: the clip gives under a load a quarter
+    // of what a square of the cloth stretches under it.
+    const double sheet = std::max(derived.settings.springs.structural.x, derived.settings.springs.structural.y);
+    const glm::dvec3 du_axis = glm::dvec3(u) * double(du), dv_axis = glm::dvec3(v) * double(dv);
+    const double cell_area = glm::length(glm::cross(du_axis, dv_axis));
+    for (const ClipWeight& w : soft_clip_weights(cloth, scene.pins)) {
+        if (state.pinned[w.particle] != 0) continue;  // absent, or a rigid point pin
+        const int r = static_cast<int>(w.particle / cloth.cols), c = static_cast<int>(w.particle % cloth.cols);
+        const int cells = shape.has_cell(r - 1, c - 1) + shape.has_cell(r - 1, c) + shape.has_cell(r, c - 1) +
+                          shape.has_cell(r, c);
+        const double k = kClipHoldFactor * sheet / (w.radius * w.radius) * (0.25 * cells * cell_area) * w.weight;
+        if (k > 0.0) {
+            topology.holds.push_back({static_cast<std::uint32_t>(w.particle), static_cast<float>(k),
+                                      state.position.get(w.particle)});
+        }
+    }
     return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
 }
 

@@ -16,6 +16,11 @@ template <class F>
 void accumulate_spring_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
                               BasicVec3Array<F>& force);
 
+// Soft clips' holds (state.hpp): F = -k (x - anchor) on each held particle, computed in double and added in
+// the force type F.
+template <class F>
+void accumulate_hold_forces(const Topology& topology, const DVec3Array& position, BasicVec3Array<F>& force);
+
 // Air velocity at a time: the wind vector scaled by deterministic gusts (two incommensurate sines, so a
 // run is reproducible and still looks irregular).
 glm::vec3 wind_velocity(const ForceSettings& forces, double time);
@@ -29,7 +34,8 @@ template <class F>
 void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
                             double rest_area, BasicVec3Array<F>& force);
 
-// Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends (J).
+// Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends and
+// 0.5 k |x - anchor|^2 over soft clips' holds (J).
 double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs);
 

@@ -231,7 +231,7 @@ void MassSpring::step() {
 // then one fused sweep over the rows that also leaves each row's box for the collision broad phase.
 void MassSpring::step_fast(double h, StepProfile* profile) {
     const Vec3Array* external = nullptr;
-    if (plan_.wind || plan_.contact) {
+    if (plan_.external_forces()) {
         force_.resize(state_.size());
         add_external_forces(state_, force_, external_, profile);  // onto zeros: the sums themselves
         if (grab_) force_.add(grab_->particle, grab_force(state_));
@@ -256,7 +256,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Springs);
         accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
     }
-    if (plan_.wind || plan_.contact) add_external_forces(state_, force_, external_, profile);
+    if (plan_.external_forces()) add_external_forces(state_, force_, external_, profile);
     if (grab_) force_.add(grab_->particle, grab_force(state_));
     {
         StageTimer timer(profile, Stage::Integrate);
@@ -430,7 +430,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
         f.resize(s.size());
-        if (plan_.wind || plan_.contact) {
+        if (plan_.external_forces()) {
             Vec3Array scratch;
             add_external_forces(s, f, scratch, nullptr);
         }
@@ -481,7 +481,8 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
     }
 }
 
-// Wind and contact are summed on their own and added last, as the fast solver adds them, so both round alike.
+// Wind, contact and soft clips are summed on their own and added last, as the fast solver adds them, so both
+// round alike.
 void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch,
                                      StepProfile* profile) const {
     scratch.resize(state.size());
@@ -493,13 +494,17 @@ void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3A
         StageTimer timer(profile, Stage::Contact);
         accumulate_contact_forces(state, settings_.colliders, scratch);
     }
+    if (plan_.holds) {
+        StageTimer timer(profile, Stage::Clips);
+        accumulate_hold_forces(topology_, state.position, scratch);
+    }
     for (std::size_t i = 0; i < state.size(); ++i) force.add(i, scratch.get(i));
 }
 
 void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
     force.resize(state.size());
     accumulate_spring_forces(topology_, state.position, settings_.springs, force);
-    if (plan_.wind || plan_.contact) {
+    if (plan_.external_forces()) {
         Vec3Array external;
         add_external_forces(state, force, external, nullptr);
     }

@@ -30,16 +30,17 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
     const SimulationSettings& settings = scene.settings;
     const Topology& topology = start.topology();
     const double rest_area = start.rest_area();
-    // The stages the simulation runs, from its own plan: wind, penalty contact (a force) or projection.
+    // The stages the simulation runs, from its own plan: wind, penalty contact (a force) or projection, soft clips.
     const StepPlan& plan = start.plan();
     const BasicForceFunction<double> forces = [&](const State& s, DVec3Array& out) {
         out.resize(s.size());
         accumulate_spring_forces(topology, s.position, settings.springs, out);
-        if (plan.wind || plan.contact) {
+        if (plan.external_forces()) {
             DVec3Array external;
             external.resize(s.size());
             if (plan.wind) accumulate_wind_forces(topology, s, settings.forces, rest_area, external);
             if (plan.contact) accumulate_contact_forces(s, settings.colliders, external);
+            if (plan.holds) accumulate_hold_forces(topology, s.position, external);
             for (std::size_t i = 0; i < s.size(); ++i) out.add(i, external.get(i));
         }
     };

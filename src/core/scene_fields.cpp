@@ -58,7 +58,7 @@ const std::array kFields = {
     FieldInfo{"forces.gust_frequency", "Hz", 0, 100, "main gust frequency", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_frequency; }},
     FieldInfo{"forces.max_speed", "m/s", 0, 1e4, "0 = off; else every particle's speed is clamped to this", [](Scene& s) -> FieldRef { return &s.settings.forces.max_speed; }},
 
-    FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest; the table's radius makes each preset pin a clip", [](Scene& s) -> FieldRef { return &s.pins; }},
+    FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest; the table's radius makes each preset pin a clip; clip = \"soft\" holds a clip's particles by springs that fade to 0 at its rim instead of pinning them (the load enters the cloth smoothly)", [](Scene& s) -> FieldRef { return &s.pins; }},
 
     FieldInfo{"colliders.sphere.enabled", "", 0, 0, "collide with the sphere", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.enabled; }},
     FieldInfo{"colliders.sphere.center", "m", -kBig, kBig, "sphere centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.center; }},
@@ -100,6 +100,7 @@ const std::array kFields = {
 
 constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corners", "top-row", "four-corners",
                                                              "left-edge"};
+constexpr std::array<std::string_view, 2> kClipHoldNames = {"rigid", "soft"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
 constexpr std::array<std::string_view, 6> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
@@ -139,6 +140,7 @@ const FieldInfo* find_field(std::string_view name) {
 }
 
 std::span<const std::string_view> pin_preset_names() { return kPinPresetNames; }
+std::span<const std::string_view> clip_hold_names() { return kClipHoldNames; }
 std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
 std::span<const std::string_view> solver_method_names() { return kSolverMethodNames; }
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
@@ -166,7 +168,7 @@ std::string describe_allowed(const FieldInfo& field) {
             [&](PinSpec*) {
                 return cat("one of ", join(kPinPresetNames),
                            ", a list of [row, col] or { particle = [row, col], radius = R }, or a table with preset, "
-                           "radius and particles; R: ",
+                           "radius, particles and clip (rigid or soft); R: ",
                            describe_pin_radius(), " (0 = a point pin)");
             },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return "one of " + join(names_of(v)); },
@@ -209,9 +211,10 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
             [&](const std::string* v) { return quoted(*v); },
             [&](const PinSpec* v) {
                 std::string preset = quoted(kPinPresetNames[static_cast<int>(v->preset)]);
-                if (v->particles.empty() && v->preset_radius == 0.0f) return preset;
+                if (v->particles.empty() && v->preset_radius == 0.0f && v->clip == ClipHold::Rigid) return preset;
                 std::string out = cat("{ preset = ", preset);
                 if (v->preset_radius != 0.0f) out += cat(", radius = ", number(v->preset_radius));
+                if (v->clip != ClipHold::Rigid) out += cat(", clip = ", quoted(clip_hold_names()[static_cast<int>(v->clip)]));
                 if (v->particles.empty()) return cat(out, " }");
                 std::string list;
                 for (const PinClip& p : v->particles) {

@@ -229,9 +229,16 @@ std::optional<PinSpec> pins_of(const toml::node& node, Rejection& rejection) {
                 auto list = pin_list_of(value, "pins.particles", rejection);
                 if (!list) return std::nullopt;
                 spec.particles = *list;
+            } else if (key.str() == "clip") {
+                const auto clip = enum_of<ClipHold>(value, clip_hold_names());
+                if (!clip) {
+                    rejection = {"pins.clip = " + show(value) + " is not a clip kind; allowed: rigid, soft", &value};
+                    return std::nullopt;
+                }
+                spec.clip = *clip;
             } else {
                 rejection = {"pins has an unknown key '" + std::string(key.str()) +
-                                 "'; allowed keys: preset, radius, particles",
+                                 "'; allowed keys: preset, radius, particles, clip",
                              &value};
                 return std::nullopt;
             }

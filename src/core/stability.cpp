@@ -57,10 +57,20 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double contact_substep = contact_k > 0.0 && std::isfinite(lightest)
                                        ? critical(std::sqrt(contact_k / lightest), c, 2.0, DampingForm::None)
                                        : std::numeric_limits<double>::infinity();
+    // Soft clips' holds: a zero-length spring to a fixed anchor adds k to its particle's diagonal alone, as
+    // contact does, and every integrator takes it explicitly, like contact.
+    double hold_rate = 0.0;  // the largest k / m of a hold (1/s^2)
+    for (const Hold& h : topology.holds) {
+        if (!state.pinned[h.particle]) hold_rate = std::max(hold_rate, double(h.stiffness) / state.mass[h.particle]);
+    }
+    const double hold_substep = hold_rate > 0.0 ? critical(std::sqrt(hold_rate), c, 2.0, DampingForm::None)
+                                                : std::numeric_limits<double>::infinity();
+    const double explicit_substep = std::min(contact_substep, hold_substep);
+    const StabilityBound explicit_bound = hold_substep < contact_substep ? StabilityBound::Clips : StabilityBound::Contact;
     if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective) {
-        limit.unconditionally_stable = !std::isfinite(contact_substep);
-        limit.critical_substep = limit.plane_wave_substep = contact_substep;
-        limit.bound = StabilityBound::Contact;
+        limit.unconditionally_stable = !std::isfinite(explicit_substep);
+        limit.critical_substep = limit.plane_wave_substep = explicit_substep;
+        limit.bound = explicit_bound;
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
@@ -68,8 +78,8 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         // Springs are projected implicitly; the damping in XPBD's explicit prediction is forward Euler on a
         // decay rate c, stable while c h < 2.
         const double damping_substep = c > 0.0 ? 2.0 / c : std::numeric_limits<double>::infinity();
-        limit.critical_substep = limit.plane_wave_substep = std::min(damping_substep, contact_substep);
-        limit.bound = damping_substep <= contact_substep ? StabilityBound::Damping : StabilityBound::Contact;
+        limit.critical_substep = limit.plane_wave_substep = std::min(damping_substep, explicit_substep);
+        limit.bound = damping_substep <= explicit_substep ? StabilityBound::Damping : explicit_bound;
         limit.unconditionally_stable = !std::isfinite(limit.critical_substep);
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
@@ -87,6 +97,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         row_sum[b.m] += 8.0 * k;
         row_sum[b.b] += 4.0 * k;
     }
+    for (const Hold& h : topology.holds) row_sum[h.particle] += h.stiffness;
     double gershgorin = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
@@ -97,7 +108,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double bending = std::max(k.bending.x, k.bending.y) * (topology.bends.empty() ? 1.0 : 4.0);
     const double sum_k = double(std::max(k.structural.x, k.structural.y)) + double(k.shear) + bending;
     limit.omega_gershgorin = std::sqrt(gershgorin);
-    limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest) : 0.0;
+    limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest + hold_rate) : 0.0;
     const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
     const DampingForm form = integrator == Integrator::SymplecticEuler ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);

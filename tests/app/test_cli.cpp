@@ -236,7 +236,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 16);
+    CHECK(stage.size() == 17);
     // drape-sphere: fast solver, sphere and ground, no wind, no cube, no cylinder, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 109);
@@ -246,7 +246,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(stage.at("sphere").at("blocks_offered") == 30 * 109 * 120);  // 40 rows of 3 blocks
     CHECK(stage.at("sphere").at("blocks_tested").get<long long>() <= 30 * 109 * 120);
     CHECK(stage.at("ground").at("blocks_tested") == 0);  // the cloth is far above the ground
-    for (const char* skipped : {"wind", "contact", "cube", "cylinder", "tethers", "strain limit", "speed limit"}) {
+    for (const char* skipped : {"wind", "contact", "clips", "cube", "cylinder", "tethers", "strain limit", "speed limit"}) {
         INFO(skipped);
         CHECK(stage.at(skipped).at("state") == "skipped");
         CHECK(stage.at(skipped).at("ms") == 0.0);
@@ -257,6 +257,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK_THAT(stage.at("cube").at("note").get<std::string>(), Contains("colliders.cube.enabled"));
     CHECK_THAT(stage.at("cylinder").at("note").get<std::string>(), Contains("colliders.cylinder.enabled"));
     CHECK_THAT(stage.at("contact").at("note").get<std::string>(), Contains("colliders.contact is projection"));
+    CHECK_THAT(stage.at("clips").at("note").get<std::string>(), Contains("no soft clip"));
     double sum = 0.0;
     for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
     CHECK(p.at("total_ms").get<double>() == Approx(sum));

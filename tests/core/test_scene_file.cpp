@@ -718,6 +718,17 @@ TEST_CASE("scene pins: clips are read from a pins list, a pins table and --set")
     // A preset name alone drops the clip radius with the rest of the old pins.
     clothsim::apply_override(s, "pins=top-corners");
     CHECK(s.pins == clothsim::PinSpec{});
+
+    // How clips hold: rigid unless the table says soft.
+    CHECK(preset.pins.clip == clothsim::ClipHold::Rigid);
+    const clothsim::Scene soft =
+        clothsim::parse_scene("pins = { preset = \"top-corners\", radius = 0.15, clip = \"soft\" }\n", "t.toml");
+    CHECK(soft.pins.clip == clothsim::ClipHold::Soft);
+    CHECK(soft.pins.preset_radius == 0.15f);
+    clothsim::apply_override(s, "pins={ preset = \"top-row\", radius = 0.01, clip = \"soft\" }");
+    CHECK(s.pins.clip == clothsim::ClipHold::Soft);
+    clothsim::apply_override(s, "pins={ preset = \"top-row\", radius = 0.01, clip = \"rigid\" }");
+    CHECK(s.pins.clip == clothsim::ClipHold::Rigid);
 }
 
 TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [row, col]") {
@@ -736,7 +747,9 @@ TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [ro
     for (const clothsim::PinSpec& pins :
          {clothsim::PinSpec{clothsim::PinPreset::FourCorners, {}, 0.125f},
           clothsim::PinSpec{clothsim::PinPreset::None, {{1, 1, 1.0f}, {0, 4, 1e-7f}}},
-          clothsim::PinSpec{clothsim::PinPreset::LeftEdge, {{3, 0, 0.1f / 3.0f}}, 0.7f}}) {
+          clothsim::PinSpec{clothsim::PinPreset::LeftEdge, {{3, 0, 0.1f / 3.0f}}, 0.7f},
+          clothsim::PinSpec{clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipHold::Soft},
+          clothsim::PinSpec{clothsim::PinPreset::None, {{2, 3, 0.05f}}, 0.0f, clothsim::ClipHold::Soft}}) {
         s.pins = pins;
         const std::string written = clothsim::to_toml(s);
         INFO(written);
@@ -749,6 +762,9 @@ TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [ro
     CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "\"top-row\"");
     s.pins = {clothsim::PinPreset::None, {{1, 1}}};
     CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "{ preset = \"none\", particles = [[1, 1]] }");
+    s.pins = {clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipHold::Soft};
+    CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) ==
+          "{ preset = \"top-corners\", radius = 0.15, clip = \"soft\" }");
 }
 
 TEST_CASE("scene pins: a bad clip is rejected with its line, the part at fault and what is allowed") {
@@ -767,8 +783,13 @@ TEST_CASE("scene pins: a bad clip is rejected with its line, the part at fault a
     // Unknown keys, in a clip and in the pins table, with the keys that are known.
     CHECK_THAT(parse_error("pins = [{ particle = [0, 0], radios = 0.1 }]\n"),
                Contains("pins[0] has an unknown key 'radios'; allowed keys: particle, radius"));
+    CHECK_THAT(parse_error("pins = { preset = \"none\", grip = 0.1 }\n"),
+               Contains("pins has an unknown key 'grip'; allowed keys: preset, radius, particles, clip"));
+    // A clip kind that is not one.
+    CHECK_THAT(parse_error("pins = { preset = \"top-corners\", radius = 0.05, clip = \"padded\" }\n"),
+               Contains("pins.clip = 'padded' is not a clip kind; allowed: rigid, soft"));
     CHECK_THAT(parse_error("pins = { preset = \"none\", clip = 0.1 }\n"),
-               Contains("pins has an unknown key 'clip'; allowed keys: preset, radius, particles"));
+               Contains("pins.clip = 0.1 is not a clip kind; allowed: rigid, soft"));
 
     // Wrong types.
     CHECK_THAT(parse_error("pins = [{ particle = [0, 0], radius = \"wide\" }]\n"),

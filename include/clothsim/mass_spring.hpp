@@ -268,7 +268,7 @@ private:
         float force_limit = 0.0f;  // N
     };
     std::optional<Grab> grab_;
-    Vec3Array grab_external_;    // N: the grab's force alone (zero but for the grabbed particle), for the fast solver
+    Vec3Array grab_external_;    // N: the grab's and soft clips' forces (zero elsewhere), for the fast solver
 };
 
 // The box around the cloth's finite particles, the enabled sphere, cube and cylinder, and down to the ground

@@ -178,9 +178,11 @@ private:
     // velocities() in double, for restarts and the energy.
     std::vector<glm::dvec3> velocities_in_double() const;
     void compute_forces(const State& state, Vec3Array& force) const;
-    // Wind and penalty contact, as the plan has them, summed on their own into `scratch` and then added to
-    // `force` (the fast solver adds them as one external force: both round alike); timed when `profile` is set.
-    void add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch, StepProfile* profile) const;
+    // Wind, penalty contact and (with `holds`) soft clips' holds, as the plan has them, summed on their own into
+    // `scratch` and then added to `force` (the fast solver adds them as one external force: both round alike);
+    // timed when `profile` is set.
+    void add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch, StepProfile* profile,
+                             bool holds = true) const;
     void replan();
     // The stages of step(), in pipeline order.
     void step_fast(double h, StepProfile* profile);

@@ -18,7 +18,8 @@ namespace clothsim {
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
 // How a clip (a pin with a radius) holds: Rigid pins every particle within the radius; Soft holds each to
 // where it is at rest by a zero-length spring whose stiffness fades to 0 at the rim (docs/MATERIAL.md,
-// "Clips"), so the strain at the clip converges as the grid is refined.
+// "Soft clips"): the load enters the cloth smoothly, and a cloth held in the plane it hangs in has a largest
+// strain that converges as the grid is refined.
 enum class ClipHold { Rigid, Soft };
 
 // The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,

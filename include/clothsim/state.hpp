@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -55,11 +56,16 @@ inline constexpr std::uint8_t kPinned = 1;
 inline constexpr std::uint8_t kAbsent = 2;
 
 // A particle of a soft clip (ClipHold::Soft), held to its anchor, where it lay at rest, by a zero-length
-// spring: F = -k (x - anchor).
+// spring: F = -k (x - anchor), k = max(k_u share_u, k_v share_v) with k_u, k_v the structural springs' constants
+// (kept up to date when they change; cloth_builder.cpp has the shares).
 struct Hold {
     std::uint32_t particle = 0;
     float stiffness = 0.0f;  // N/m
     glm::dvec3 anchor{0.0};  // m
+    float share_u = 0.0f, share_v = 0.0f;
+    float stiffness_for(const glm::vec2& structural) const {
+        return std::max(structural.x * share_u, structural.y * share_v);
+    }
 };
 
 struct Topology {

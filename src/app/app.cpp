@@ -178,12 +178,28 @@ Ray cursor_ray(const AppState& app, const Window& window, float scale) {
     return ray_through(app.camera, glm::vec2(x - r.x, y - r.y), glm::vec2(r.z, r.w));
 }
 
-// Converts the pins of the running simulation to the scene's explicit list, so "Save scene" keeps them.
+// Converts the pins of the running simulation to the scene's explicit list, so "Save scene" keeps them. Soft
+// clips hold their particles without pinning them: they stay clips (the preset's as explicit ones).
 void pins_to_scene(AppState& app) {
     const int cols = app.sim.topology().cols;  // the running cloth, even if an edit of the grid failed to rebuild
+    PinSpec& pins = app.scene.pins;
+    std::vector<PinClip> soft;
+    if (pins.clip == ClipHold::Soft) {
+        ClothSettings cloth = app.scene.cloth;
+        cloth.rows = app.sim.topology().rows;
+        cloth.cols = cols;
+        if (pins.preset_radius > 0.0f) {
+            for (std::size_t i : pinned_particles(cloth, PinSpec{pins.preset, {}, 0.0f, ClipHold::Rigid})) {
+                soft.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols, pins.preset_radius});
+            }
+        }
+        for (const PinClip& p : pins.particles) {
+            if (p.radius > 0.0f) soft.push_back(p);
+        }
+    }
     app.scene.pins.preset = PinPreset::None;
     app.scene.pins.preset_radius = 0.0f;
-    app.scene.pins.particles.clear();
+    app.scene.pins.particles = std::move(soft);
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
         if (app.sim.state().pinned[i] == kPinned) {
             app.scene.pins.particles.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols});

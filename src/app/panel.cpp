@@ -125,14 +125,20 @@ bool pin_combo(const std::string& label, PinSpec* v) {
             }
         }
         ImGui::Separator();
-        // Only clips (pins with a radius) can be soft; point pins stay rigid.
+        // Only clips (pins with a radius) can be soft; point pins stay rigid, so without a clip the switch is
+        // shown but cannot be used.
+        const bool clips = v->preset_radius > 0.0f ||
+                           std::any_of(v->particles.begin(), v->particles.end(), [](const PinClip& p) { return p.radius > 0.0f; });
         bool soft = v->clip == ClipHold::Soft;
+        ImGui::BeginDisabled(!clips && !soft);
         if (ImGui::Checkbox("soft clips", &soft)) {
             v->clip = soft ? ClipHold::Soft : ClipHold::Rigid;
             edited = true;
         }
-        if (ImGui::IsItemHovered()) {
-            ImGui::SetTooltip("Hold each clip's particles by springs that fade to 0 at its rim instead of pinning them");
+        ImGui::EndDisabled();
+        if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+            ImGui::SetTooltip(clips ? "Hold each clip's particles by springs that fade to 0 at its rim instead of pinning them"
+                                    : "Only clips can be soft: give the pins a radius (pins = { ..., radius = R })");
         }
         ImGui::EndCombo();
     }

@@ -229,22 +229,26 @@ MassSpring build_simulation(const Scene& scene) {
     Scene derived = scene;
     derive_springs(derived);
     // Soft clips: each particle held with k = kappa A w, its rest area A (a quarter of each cell it borders)
-    // and its weight w; kappa = kClipHoldFactor E / R^2 per unit area, E the structural springs' stiffness.
-    // A whole disc then holds with kappa R^2 (pi / 3) = 4.2 E in all: the clip gives under a load a quarter
-    // of what a square of the cloth stretches under it.
-    const double sheet = std::max(derived.settings.springs.structural.x, derived.settings.springs.structural.y);
+    // and its weight w; kappa = kClipHoldFactor E / R^2 per unit area, E the sheet's stretch stiffness, the
+    // larger of k_u h_u / h_v and k_v h_v / h_u (a row of springs k every h apart across). A whole disc then
+    // holds with kappa R^2 (pi / 3) = 4.2 E in all: the clip gives under a load a quarter of what a square of
+    // the cloth stretches under it. R is taken at least one spacing, so a clip that holds its own particle
+    // only holds it with k <= 4 E.
     const glm::dvec3 du_axis = glm::dvec3(u) * double(du), dv_axis = glm::dvec3(v) * double(dv);
     const double cell_area = glm::length(glm::cross(du_axis, dv_axis));
+    const double aspect = du > 0.0f && dv > 0.0f ? double(du) / double(dv) : 1.0;  // h_u / h_v
+    const double spacing = std::max(du, dv);
     for (const ClipWeight& w : soft_clip_weights(cloth, scene.pins)) {
         if (state.pinned[w.particle] != 0) continue;  // absent, or a rigid point pin
         const int r = static_cast<int>(w.particle / cloth.cols), c = static_cast<int>(w.particle % cloth.cols);
         const int cells = shape.has_cell(r - 1, c - 1) + shape.has_cell(r - 1, c) + shape.has_cell(r, c - 1) +
                           shape.has_cell(r, c);
-        const double k = kClipHoldFactor * sheet / (w.radius * w.radius) * (0.25 * cells * cell_area) * w.weight;
-        if (k > 0.0) {
-            topology.holds.push_back({static_cast<std::uint32_t>(w.particle), static_cast<float>(k),
-                                      state.position.get(w.particle)});
-        }
+        const double radius = std::max(w.radius, spacing);
+        const double share = kClipHoldFactor / (radius * radius) * (0.25 * cells * cell_area) * w.weight;
+        Hold hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
+                  static_cast<float>(share * aspect), static_cast<float>(share / aspect)};
+        hold.stiffness = hold.stiffness_for(derived.settings.springs.structural);
+        if (hold.stiffness > 0.0f) topology.holds.push_back(hold);
     }
     return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
 }

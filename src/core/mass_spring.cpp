@@ -141,6 +141,10 @@ void MassSpring::apply(const SimulationSettings& settings) {
     if (settings.springs != settings_.springs || settings.integration != settings_.integration) {
         iterative_.invalidate();
     }
+    // Soft clips hold in proportion to the sheet's stiffness.
+    if (settings.springs.structural != settings_.springs.structural) {
+        for (Hold& hold : topology_.holds) hold.stiffness = hold.stiffness_for(settings.springs.structural);
+    }
     settings_ = settings;
     replan();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
@@ -473,8 +477,15 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
             last_iterations_ = 1;
         } break;
         case Integrator::Projective: {
-            // Wind, contact and a grab are held at their value at the start of the substep.
-            external(state_, force_);
+            // Wind, contact and a grab are held at their value at the start of the substep; soft clips' holds
+            // are quadratic and in the solver's matrix (projective.hpp): held fixed over a BDF2 step they would
+            // feed it energy.
+            force_.resize(state_.size());
+            if (plan_.wind || plan_.contact) {
+                Vec3Array scratch;
+                add_external_forces(state_, force_, scratch, nullptr, false);
+            }
+            if (grab_) force_.add(grab_->particle, grab_force(state_));
             ProjectiveSolver::Inputs inputs;
             inputs.external = &force_;
             inputs.gravity = settings_.forces.gravity;
@@ -493,7 +504,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
 // Wind, contact and soft clips are summed on their own and added last, as the fast solver adds them, so both
 // round alike.
 void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch,
-                                     StepProfile* profile) const {
+                                     StepProfile* profile, bool holds) const {
     scratch.resize(state.size());
     if (plan_.wind) {
         StageTimer timer(profile, Stage::Wind);
@@ -503,7 +514,7 @@ void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3A
         StageTimer timer(profile, Stage::Contact);
         accumulate_contact_forces(state, settings_.colliders, scratch);
     }
-    if (plan_.holds) {
+    if (plan_.holds && holds) {
         StageTimer timer(profile, Stage::Clips);
         accumulate_hold_forces(topology_, state.position, scratch);
     }

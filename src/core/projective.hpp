@@ -12,7 +12,7 @@
 // and the pins stay: it is factorised once (sparse Cholesky, Eigen's SimplicialLDLT with an AMD ordering)
 // and each iteration is one pair of triangular solves for x, y and z together. A backtracking line search
 // makes every iteration lower g, so the step is stable at any stiffness and substep; more iterations converge
-// to BDF2 itself. Bends and rest-length-0 springs are quadratic: A holds them exactly.
+// to BDF2 itself. Bends, rest-length-0 springs and soft clips' holds are quadratic: A holds them exactly.
 #pragma once
 
 #include "clothsim/settings.hpp"
@@ -26,7 +26,8 @@ namespace clothsim {
 class ProjectiveSolver {
 public:
     // What each step needs besides the state: the forces held fixed over the substep (wind, contact, a grab,
-    // evaluated at its start), gravity and the damping rate c (1/s, a = F/m + g - c v).
+    // evaluated at its start; not soft clips' holds, which the step takes implicitly from the topology),
+    // gravity and the damping rate c (1/s, a = F/m + g - c v).
     struct Inputs {
         const Vec3Array* external = nullptr;  // N, or null for none
         glm::vec3 gravity{0.0f};

@@ -58,7 +58,8 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
                                        ? critical(std::sqrt(contact_k / lightest), c, 2.0, DampingForm::None)
                                        : std::numeric_limits<double>::infinity();
     // Soft clips' holds: a zero-length spring to a fixed anchor adds k to its particle's diagonal alone, as
-    // contact does, and every integrator takes it explicitly, like contact.
+    // contact does. Every integrator but projective takes it explicitly, like contact; projective has it in its
+    // matrix (projective.hpp).
     double hold_rate = 0.0;  // the largest k / m of a hold (1/s^2)
     for (const Hold& h : topology.holds) {
         if (!state.pinned[h.particle]) hold_rate = std::max(hold_rate, double(h.stiffness) / state.mass[h.particle]);
@@ -68,9 +69,11 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double explicit_substep = std::min(contact_substep, hold_substep);
     const StabilityBound explicit_bound = hold_substep < contact_substep ? StabilityBound::Clips : StabilityBound::Contact;
     if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective) {
-        limit.unconditionally_stable = !std::isfinite(explicit_substep);
-        limit.critical_substep = limit.plane_wave_substep = explicit_substep;
-        limit.bound = explicit_bound;
+        const bool projective = integrator == Integrator::Projective;
+        const double substep = projective ? contact_substep : explicit_substep;
+        limit.unconditionally_stable = !std::isfinite(substep);
+        limit.critical_substep = limit.plane_wave_substep = substep;
+        limit.bound = projective ? StabilityBound::Contact : explicit_bound;
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }

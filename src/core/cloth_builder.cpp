@@ -248,7 +248,7 @@ MassSpring build_simulation(const Scene& scene) {
         Hold hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
                   static_cast<float>(share * aspect), static_cast<float>(share / aspect)};
         hold.stiffness = hold.stiffness_for(derived.settings.springs.structural);
-        if (hold.stiffness > 0.0f) topology.holds.push_back(hold);
+        if (share > 0.0) topology.holds.push_back(hold);  // kept at k = 0 too: the springs may be raised later
     }
     return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
 }

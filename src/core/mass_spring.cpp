@@ -143,7 +143,9 @@ void MassSpring::apply(const SimulationSettings& settings) {
     }
     // Soft clips hold in proportion to the sheet's stiffness.
     if (settings.springs.structural != settings_.springs.structural) {
-        for (Hold& hold : topology_.holds) hold.stiffness = hold.stiffness_for(settings.springs.structural);
+        for (Hold& hold : topology_.holds) {
+            if (hold.share_u > 0.0f || hold.share_v > 0.0f) hold.stiffness = hold.stiffness_for(settings.springs.structural);
+        }
     }
     settings_ = settings;
     replan();

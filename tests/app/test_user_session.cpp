@@ -29,6 +29,17 @@ const std::string kEveryDebugView = "wireframe,springs=kind,particles";  // pins
 
 // A pin's marker: drawn in (0.9, 0.1, 0.1) over everything else.
 bool is_pin_red(Rgb c) { return c.r > 180 && c.g < 90 && c.b < 90; }
+bool is_hold_orange(Rgb c) { return c.r > 200 && c.g > 110 && c.g < 190 && c.b < 60; }
+
+bool orange_near(const Image& image, glm::vec3 screen, int radius) {
+    for (int dy = -radius; dy <= radius; ++dy) {
+        for (int dx = -radius; dx <= radius; ++dx) {
+            const int x = static_cast<int>(screen.x) + dx, y = static_cast<int>(screen.y) + dy;
+            if (x >= 0 && y >= 0 && x < image.width && y < image.height && is_hold_orange(image.at(x, y))) return true;
+        }
+    }
+    return false;
+}
 
 bool red_near(const Image& image, glm::vec3 screen, int radius) {
     for (int dy = -radius; dy <= radius; ++dy) {
@@ -131,6 +142,31 @@ TEST_CASE("user session: every particle a clip holds shows a pin marker, the fre
     }
     // [12, 22] lies 0.17 m from the clip's centre: free, and drawn as cloth.
     CHECK_FALSE(red_near(image, particle_on_screen(scene, 12 * 36 + 22), 2));
+}
+
+TEST_CASE("user session: a soft clip's particles show orange hold markers, not pin markers") {
+    // The clip of the test above, soft: its particles are held, not pinned.
+    const std::string clips =
+        "pins={ preset = \"left-edge\", particles = [{ particle = [12, 18], radius = 0.15 }], clip = \"soft\" }";
+    clothsim::Scene scene = clothsim::load_scene("flag");
+    clothsim::apply_override(scene, clips);
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    REQUIRE(sim.topology().holds.size() > 20);
+    const TempDir dir("session_soft_clip_markers");
+    const RunResult r =
+        run_user_session(dir, {"--scene", "flag", "--set", clips, "--paused"}, "shot start.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const Image image = load_png(dir / "start.png");
+    REQUIRE(image.width == kWidth);
+    for (const clothsim::Hold& hold : sim.topology().holds) {
+        INFO("held " << hold.particle);
+        CHECK(orange_near(image, particle_on_screen(scene, hold.particle), 2));
+        CHECK_FALSE(red_near(image, particle_on_screen(scene, hold.particle), 1));
+    }
+    // The left edge's point pins stay rigid: red.
+    CHECK(red_near(image, particle_on_screen(scene, 0), 3));
+    CHECK_FALSE(orange_near(image, particle_on_screen(scene, 12 * 36 + 23), 2));  // free, 0.21 m away
 }
 
 TEST_CASE("user session: Reset while paused shows the start state, debug views included") {

@@ -305,6 +305,27 @@ TEST_CASE("soft clip: the holds follow the sheet's stiffness when the springs ch
     wide.cloth.size = glm::vec2(2.0f, 1.0f);  // h_u = 0.1, h_v = 0.05
     const MassSpring w = build_simulation(wide);
     for (const Hold& h : w.topology().holds) CHECK(h.share_u == Approx(4.0 * h.share_v).epsilon(1e-6));
+    // The clip's own particle on the top edge (half a cell's area each side): k = 4 E A / R^2 with
+    // E = max(200 * 0.1 / 0.05, 200 * 0.05 / 0.1) = 400 N/m.
+    const auto centre = std::find_if(w.topology().holds.begin(), w.topology().holds.end(),
+                                     [](const Hold& h) { return h.particle == 10u; });
+    REQUIRE(centre != w.topology().holds.end());
+    CHECK(centre->stiffness == Approx(4.0 * 400.0 * (0.5 * 0.1 * 0.05) / (0.15 * 0.15)).epsilon(1e-5));
+}
+
+TEST_CASE("soft clip: a clip narrower than the spacing holds its particle like one a spacing wide", "[soft_clip]") {
+    // Radius 0.01 m at a spacing of 0.1 m: only the clip's particle, with kappa from R = 0.1 m, k = 4 E A / h^2.
+    const MassSpring sim = build_simulation(clipped_sheet(11, 5, 5, 0.01f, ClipHold::Soft));
+    REQUIRE(sim.topology().holds.size() == 1);
+    CHECK(sim.topology().holds[0].stiffness == Approx(4.0 * 200.0).epsilon(1e-5));
+    // A sheet built without structural stiffness keeps its holds at k = 0, and they hold once it has some.
+    Scene limp = clipped_sheet(11, 5, 5, 0.3f, ClipHold::Soft);
+    limp.settings.springs.structural = glm::vec2(0.0f);
+    MassSpring held = build_simulation(limp);
+    REQUIRE_FALSE(held.topology().holds.empty());
+    CHECK(held.topology().holds[0].stiffness == 0.0f);
+    test::edit_settings(held, [](SimulationSettings& st) { st.springs.structural = glm::vec2(200.0f); });
+    CHECK(held.topology().holds[0].stiffness > 0.0f);
 }
 
 TEST_CASE("soft clip: the largest strain no longer doubles as the grid is refined", "[soft_clip][material]") {

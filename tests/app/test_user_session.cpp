@@ -29,26 +29,23 @@ const std::string kEveryDebugView = "wireframe,springs=kind,particles";  // pins
 
 // A pin's marker: drawn in (0.9, 0.1, 0.1) over everything else.
 bool is_pin_red(Rgb c) { return c.r > 180 && c.g < 90 && c.b < 90; }
+// A soft clip's hold marker: (1.0, 0.6, 0.0), smaller.
 bool is_hold_orange(Rgb c) { return c.r > 200 && c.g > 110 && c.g < 190 && c.b < 60; }
 
-bool orange_near(const Image& image, glm::vec3 screen, int radius) {
+// Whether a pixel within `radius` of `screen` has a marker's colour.
+template <class Colour>
+bool colour_near(const Image& image, glm::vec3 screen, int radius, Colour is_colour) {
     for (int dy = -radius; dy <= radius; ++dy) {
         for (int dx = -radius; dx <= radius; ++dx) {
             const int x = static_cast<int>(screen.x) + dx, y = static_cast<int>(screen.y) + dy;
-            if (x >= 0 && y >= 0 && x < image.width && y < image.height && is_hold_orange(image.at(x, y))) return true;
+            if (x >= 0 && y >= 0 && x < image.width && y < image.height && is_colour(image.at(x, y))) return true;
         }
     }
     return false;
 }
-
-bool red_near(const Image& image, glm::vec3 screen, int radius) {
-    for (int dy = -radius; dy <= radius; ++dy) {
-        for (int dx = -radius; dx <= radius; ++dx) {
-            const int x = static_cast<int>(screen.x) + dx, y = static_cast<int>(screen.y) + dy;
-            if (x >= 0 && y >= 0 && x < image.width && y < image.height && is_pin_red(image.at(x, y))) return true;
-        }
-    }
-    return false;
+bool red_near(const Image& image, glm::vec3 screen, int radius) { return colour_near(image, screen, radius, is_pin_red); }
+bool orange_near(const Image& image, glm::vec3 screen, int radius) {
+    return colour_near(image, screen, radius, is_hold_orange);
 }
 
 // Where the app's start camera shows particle `i` of `scene`'s initial cloth.

@@ -8,7 +8,7 @@
 
 namespace clothsim {
 
-// Writes positions, per-vertex UVs and the cloth's triangles. Returns false (with `error` set) on failure.
+// Writes positions, per-vertex UVs and the cloth's triangles; a torn cloth split along its tears (cloth_surface.hpp). Returns false (with `error` set) on failure.
 bool write_obj(const MassSpring& sim, const std::string& path, std::string& error);
 
 // CSV with header `step,time,particle,x,y,z`, one row per particle per recorded step.

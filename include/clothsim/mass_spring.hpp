@@ -25,6 +25,7 @@
 #include "clothsim/state.hpp"
 #include "clothsim/step_plan.hpp"
 #include "clothsim/step_profile.hpp"
+#include "clothsim/cloth_surface.hpp"
 #include "clothsim/colliders.hpp"
 #include "clothsim/self_collision.hpp"
 #include "clothsim/tethers.hpp"
@@ -114,6 +115,9 @@ public:
     double self_collision_spacing() const { return spacing_; }
     // Changes whenever the springs or triangles change (a tear), so a renderer rebuilds its mesh.
     std::uint64_t topology_stamp() const { return topology_stamp_; }
+    // The surface to draw and export: split along the tears once the cloth has torn (cloth_surface.hpp), made
+    // anew whenever the topology changes.
+    const ClothSurface& surface() const { return surface_; }
     // How far the last substep's solve got (0 for the explicit integrators): implicit Euler's CG iterations and
     // |b - A dv| / |b|; projective's quasi-Newton iterations and relative force imbalance (projective.hpp);
     // XPBD's one iteration and its constraint residual |C + alpha~ lambda| / |C| at the current positions.
@@ -241,6 +245,7 @@ private:
     std::uint64_t history_stamp_ = 0;  // stamp_ as the last substep left it; 0 after a restart
     std::size_t broken_springs_ = 0;
     std::uint64_t topology_stamp_ = 0;
+    ClothSurface surface_;       // follows topology_ (topology_changed)
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;

@@ -13,17 +13,22 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
     const Topology& t = sim.topology();
     out << "# clothsim mesh: " << t.rows << " x " << t.cols << " particles, t = " << sim.time() << " s\n";
     out.precision(9);
-    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-        const glm::vec3 p = sim.position(i);
-        out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
-    }
+    // A torn cloth is written split along its tears (cloth_surface.hpp): its split vertices follow the particles.
+    const ClothSurface& surface = sim.surface();
+    std::vector<glm::vec3> vertices = sim.positions();
+    if (surface.split()) place_split_vertices(surface, vertices);
+    for (const glm::vec3& p : vertices) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    auto uv = [&](glm::vec2 grid) {  // grid: (column, row)
+        out << "vt " << (t.cols > 1 ? grid.x / float(t.cols - 1) : 0.0f) << ' '
+            << (t.rows > 1 ? 1.0f - grid.y / float(t.rows - 1) : 0.0f) << '\n';
+    };
     for (int r = 0; r < t.rows; ++r) {
-        for (int c = 0; c < t.cols; ++c) {
-            out << "vt " << (t.cols > 1 ? float(c) / float(t.cols - 1) : 0.0f) << ' '
-                << (t.rows > 1 ? 1.0f - float(r) / float(t.rows - 1) : 0.0f) << '\n';
-        }
+        for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
     }
-    for (const auto& tri : t.triangles) {
+    if (surface.split()) {
+        for (const glm::vec2& grid : surface.split_grid) uv(grid);
+    }
+    for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
         out << "f " << tri[0] + 1 << '/' << tri[0] + 1 << ' ' << tri[1] + 1 << '/' << tri[1] + 1 << ' '
             << tri[2] + 1 << '/' << tri[2] + 1 << '\n';
     }

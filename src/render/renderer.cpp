@@ -152,19 +152,33 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
     const auto start = Clock::now();
     const Topology& t = sim.topology();
     positions_ = sim.positions();
-    compute_vertex_normals(t, sim.state().position, normals_);
+    // A torn cloth is drawn split along its tears (cloth_surface.hpp): the split vertices follow the particles.
+    const ClothSurface& surface = sim.surface();
+    if (surface.split()) {
+        surface_vertices_ = positions_;
+        place_split_vertices(surface, surface_vertices_);
+        split_surface_normals(surface, surface_vertices_, normals_);
+    } else {
+        surface_vertices_.clear();
+        compute_vertex_normals(t, sim.state().position, normals_);
+    }
+    const std::vector<glm::vec3>& vertices = surface.split() ? surface_vertices_ : positions_;
     const auto normals_done = Clock::now();
     if (rebuild) {
         MeshData data;
-        data.positions = positions_;
+        data.positions = vertices;
         data.normals = normals_;
+        auto uv = [&](glm::vec2 grid) {  // grid: (column, row)
+            data.uvs.emplace_back(t.cols > 1 ? grid.x / float(t.cols - 1) : 0.0f,
+                                  t.rows > 1 ? 1.0f - grid.y / float(t.rows - 1) : 0.0f);
+        };
         for (int r = 0; r < t.rows; ++r) {
-            for (int c = 0; c < t.cols; ++c) {
-                data.uvs.emplace_back(t.cols > 1 ? float(c) / float(t.cols - 1) : 0.0f,
-                                      t.rows > 1 ? 1.0f - float(r) / float(t.rows - 1) : 0.0f);
-            }
+            for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
         }
-        for (const auto& tri : t.triangles) data.indices.insert(data.indices.end(), tri.begin(), tri.end());
+        for (const glm::vec2& grid : surface.split_grid) uv(grid);
+        for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
+            data.indices.insert(data.indices.end(), tri.begin(), tri.end());
+        }
         cloth_.emplace(data, true);
         // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
         glm::vec2 extent(0.0f);
@@ -174,7 +188,7 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
         }
         cloth_uv_scale_ = glm::max(extent / 0.12f, glm::vec2(1.0f));
     } else {
-        cloth_->update_positions_normals(positions_, normals_);
+        cloth_->update_positions_normals(vertices, normals_);
     }
     synced_stamp_ = sim.change_stamp();
     synced_topology_stamp_ = sim.topology_stamp();
@@ -222,7 +236,7 @@ void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_
     shadow_.use();
     shadow_.set("u_light_view_projection", light_view_projection);
     shadow_.set("u_model", glm::mat4(1.0f));
-    if (input.sim.topology().triangles.size() > 0) cloth_->draw();
+    if (!input.sim.topology().triangles.empty() || input.sim.surface().split()) cloth_->draw();
     const ColliderSettings& c = input.sim.settings().colliders;
     if (c.sphere.enabled) {
         shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.sphere.center), glm::vec3(c.sphere.radius)));
@@ -292,7 +306,7 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
         lit_.set("u_model", cylinder_model(c.cylinder));
         cylinder_.draw();
     }
-    if (!input.view.wireframe && !input.sim.topology().triangles.empty()) {
+    if (!input.view.wireframe && (!input.sim.topology().triangles.empty() || input.sim.surface().split())) {
         material(input.view.texture ? glm::vec4(1.0f) : glm::vec4(0.80f, 0.36f, 0.26f, 1.0f),
                  input.view.texture ? &fabric_ : nullptr, cloth_uv_scale_, 0.08f, 12.0f);
         lit_.set("u_model", glm::mat4(1.0f));
@@ -323,10 +337,13 @@ void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projec
 
     if (view.wireframe) {
         const glm::vec4 wire(0.95f, 0.55f, 0.35f, 1.0f);
-        for (const auto& t : sim.topology().triangles) {
+        const ClothSurface& surface = sim.surface();
+        const bool split = surface.split() && surface_vertices_.size() == surface.vertex_count();
+        const std::span<const glm::vec3> vertices = split ? std::span<const glm::vec3>(surface_vertices_) : positions;
+        for (const auto& t : split ? surface.triangles : sim.topology().triangles) {
             for (int e = 0; e < 3; ++e) {
-                debug_.push_back({positions[t[e]], wire});
-                debug_.push_back({positions[t[(e + 1) % 3]], wire});
+                debug_.push_back({vertices[t[e]], wire});
+                debug_.push_back({vertices[t[(e + 1) % 3]], wire});
             }
         }
         flush(GL_LINES);

@@ -104,6 +104,7 @@ private:
     // sync_cloth writes them, all together, so the copy, the mesh and the stamp always describe one cloth.
     std::optional<GpuMesh> cloth_;
     std::vector<glm::vec3> positions_, normals_;
+    std::vector<glm::vec3> surface_vertices_;  // a torn cloth's: positions_ and then its split vertices
     std::uint64_t synced_stamp_ = 0;  // the change_stamp of positions_ (0: none; stamps start at 1)
     std::uint64_t synced_topology_stamp_ = 0;  // the topology_stamp the mesh's triangles belong to
     ClothTimings cloth_timings_;

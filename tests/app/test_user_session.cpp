@@ -298,6 +298,45 @@ TEST_CASE("user session: shift + right-drag across the paused curtain cuts it, a
     CHECK_THAT(r.err, !Contains("guard"));
 }
 
+TEST_CASE("user session: a slit cut up into the paused curtain shows as a seam, not a gap; played on, it parts") {
+    const clothsim::Scene scene = clothsim::load_scene("curtain");
+    const int cols = scene.cloth.cols, rows = scene.cloth.rows;
+    auto on_screen = [&](int row, int col) { return particle_on_screen(scene, static_cast<std::size_t>(row * cols + col)); };
+    // The stroke runs up between the middle columns, from below the hem to row 20.
+    const int left_col = cols / 2 - 1;
+    auto slit = [&](int row) { return 0.5f * (on_screen(row, left_col) + on_screen(row, left_col + 1)); };
+    const glm::vec3 bottom = slit(rows - 1), top = slit(20);
+    const TempDir dir("session_slit");
+    const RunResult r = run_user_session(
+        dir, {"--scene", "curtain", "--paused", "--view", "no-texture"},
+        "cut " + std::to_string(int(bottom.x)) + " " + std::to_string(int(bottom.y) + 30) + " " +
+            std::to_string(int(top.x)) + " " + std::to_string(int(top.y)) +
+            "\nshot cut.png\nkey space\nsleep 2\nshot played.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const Image cut = load_png(dir / "cut.png"), played = load_png(dir / "played.png");
+    REQUIRE(cut.width == kWidth);
+    REQUIRE(played.width == kWidth);
+    auto cloth_at = [](const Image& image, glm::vec3 p) {  // untextured cloth is salmon: red well above blue
+        int cloth = 0;
+        for (int dy = -2; dy <= 2; ++dy) {
+            for (int dx = -2; dx <= 2; ++dx) {
+                const Rgb c = image.at(int(p.x) + dx, int(p.y) + dy);
+                cloth += c.r - c.b > 40 ? 1 : 0;
+            }
+        }
+        return cloth > 20;  // of 25 pixels
+    };
+    // Paused, the cut cloth has not moved: its two sides meet along the seam. Drawn without the split
+    // (the torn cells' triangles dropped), a column of cells about 11 px wide would show the sky there.
+    for (int row = 24; row < rows - 1; row += 3) {
+        INFO("row " << row << " at " << slit(row).x << ", " << slit(row).y);
+        CHECK(cloth_at(cut, slit(row)));
+    }
+    CHECK(cloth_at(played, on_screen(10, cols / 2)));  // played on, the curtain still hangs
+    CHECK_THAT(r.err, !Contains("guard"));
+}
+
 TEST_CASE("user session: typed out-of-range values are clamped with a note, and Save writes a file Open accepts") {
     const TempDir dir("session_typed");
     // Forces open; wind speed typed 1e9 (allowed |wind| components up to 1e4), damping typed 1e9.

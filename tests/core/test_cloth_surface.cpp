@@ -1,0 +1,195 @@
+// The surface of a torn cloth (cloth_surface.hpp): split along the tears, so that a cut shows as a seam
+// and an opened tear as a crack, never as a missing row of cells, and no triangle spans a broken spring.
+#include "support.hpp"
+
+#include "clothsim/cloth_surface.hpp"
+#include "clothsim/scene.hpp"
+#include "clothsim/tearing.hpp"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+using namespace clothsim;
+
+namespace {
+
+constexpr int kSide = 8;
+constexpr double kSpacing = 0.1;  // m: a 0.7 m square of 8 x 8
+
+// A flat, free, weightless 8 x 8 cloth in the plane y = 1, rows along +z: u x v = -y.
+MassSpring flat_cloth() {
+    Scene s;
+    s.cloth.rows = s.cloth.cols = kSide;
+    s.cloth.size = {0.7f, 0.7f};
+    s.cloth.origin = {0.0f, 1.0f, 0.0f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    s.pins.preset = PinPreset::None;
+    s.settings.forces.gravity = glm::vec3(0.0f);
+    s.settings.colliders.ground.enabled = false;
+    return build_simulation(s);
+}
+
+std::vector<glm::vec3> surface_vertices(const MassSpring& sim) {
+    std::vector<glm::vec3> v = sim.positions();
+    place_split_vertices(sim.surface(), v);
+    return v;
+}
+
+double area(const std::vector<glm::vec3>& v, const std::array<std::uint32_t, 3>& t) {
+    return 0.5 * glm::length(glm::cross(glm::dvec3(v[t[1]] - v[t[0]]), glm::dvec3(v[t[2]] - v[t[0]])));
+}
+
+// The piece of the cloth each surface vertex belongs to: a particle's own; an edge point's from-particle's;
+// a centre's, that of its first corner.
+std::vector<std::uint32_t> vertex_pieces(const MassSpring& sim) {
+    std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    const ClothSurface& s = sim.surface();
+    for (const auto& e : s.edge_points) piece.push_back(piece[e.from]);
+    for (const auto& c : s.centres) piece.push_back(piece[c.corner[0][0]]);
+    return piece;
+}
+
+bool held(const Topology& t, std::uint32_t a, std::uint32_t b) {
+    for (const Spring& s : t.springs) {
+        if (s.kind != SpringKind::Bending && ((s.a == a && s.b == b) || (s.a == b && s.b == a))) return true;
+    }
+    return false;
+}
+
+// Every triangle lies in one piece and joins particles only along springs that hold.
+void check_surface_respects_the_tears(const MassSpring& sim) {
+    const ClothSurface& s = sim.surface();
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    for (const auto& t : s.triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+            CHECK(piece[a] == piece[b]);
+            if (a < s.particles && b < s.particles) CHECK(held(sim.topology(), a, b));
+        }
+    }
+}
+
+double piece_area(const MassSpring& sim, const std::vector<glm::vec3>& v, std::uint32_t label) {
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    double sum = 0.0;
+    for (const auto& t : sim.surface().triangles) sum += piece[t[0]] == label ? area(v, t) : 0.0;
+    return sum;
+}
+
+// Cuts every spring that crosses the plane z = 0.35 (between rows 3 and 4).
+std::size_t cut_between_rows_3_and_4(MassSpring& sim) {
+    return sim.cut([](glm::vec3 a, glm::vec3 b) { return (a.z - 0.35f) * (b.z - 0.35f) < 0.0f; });
+}
+
+}  // namespace
+
+TEST_CASE("cloth surface: an untorn cloth, square or disc, is drawn from the topology's triangles", "[tearing]") {
+    const MassSpring square = flat_cloth();
+    CHECK_FALSE(square.surface().split());
+    CHECK(square.surface().vertex_count() == square.particle_count());
+    const MassSpring disc = build_simulation(test::disc_specimen(15));
+    CHECK_FALSE(disc.surface().split());
+}
+
+TEST_CASE("cloth surface: a straight cut through a flat cloth is a closed seam: the area stays, the split "
+          "vertices meet, no triangle spans it", "[tearing]") {
+    MassSpring sim = flat_cloth();
+    const double whole = 0.7 * 0.7;
+    REQUIRE(cut_between_rows_3_and_4(sim) > 0);
+    const ClothSurface& s = sim.surface();
+    REQUIRE(s.split());
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    REQUIRE(v.size() == s.vertex_count());
+    double total = 0.0;
+    for (const auto& t : s.triangles) {
+        total += area(v, t);
+        const glm::vec3 n = glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
+        CHECK(n.y < 0.0f);  // counter-clockwise seen from u x v, as the topology's triangles
+    }
+    // Dropping the torn cells' triangles would leave 0.7 x 0.1 m^2 out.
+    CHECK(total == Approx(whole).epsilon(1e-5));
+    // The two ends of each broken edge have points of their own, and on the uncut flat cloth they coincide.
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
+        for (std::size_t j = i + 1; j < s.edge_points.size(); ++j) {
+            const auto &a = s.edge_points[i], &b = s.edge_points[j];
+            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
+            ++pairs;
+            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) < 1e-6f);
+        }
+    }
+    CHECK(pairs == kSide);  // one per column: the vertical springs the cut crossed
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: an opened cut is a crack as wide as the pieces parted, each piece whole to the seam",
+          "[tearing]") {
+    MassSpring sim = flat_cloth();
+    REQUIRE(cut_between_rows_3_and_4(sim) > 0);
+    // The lower rows (4 to 7) moved 5 cm along +z, rigidly.
+    const float parted = 0.05f;
+    for (std::size_t i = 4 * kSide; i < sim.particle_count(); ++i) {
+        sim.set_particle(i, sim.position(i) + glm::vec3(0.0f, 0.0f, parted), glm::vec3(0.0f));
+    }
+    const ClothSurface& s = sim.surface();
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    REQUIRE(piece[0] != piece[sim.particle_count() - 1]);
+    // Each piece reaches half a cell beyond its last row: rows 0 to 3 and a half, rows 3 and a half to 7.
+    CHECK(piece_area(sim, v, piece[0]) == Approx(0.7 * 0.35).epsilon(1e-5));
+    CHECK(piece_area(sim, v, piece[sim.particle_count() - 1]) == Approx(0.7 * 0.35).epsilon(1e-5));
+    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
+        for (std::size_t j = 0; j < s.edge_points.size(); ++j) {
+            const auto &a = s.edge_points[i], &b = s.edge_points[j];
+            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
+            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) == Approx(parted).epsilon(1e-4));
+        }
+    }
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: a particle cut free keeps its own patch, one cell of cloth around it", "[tearing]") {
+    MassSpring sim = flat_cloth();
+    const std::size_t lone = 3 * kSide + 3;
+    const glm::vec3 p = sim.position(lone);
+    REQUIRE(sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a == p) != (b == p); }) > 0);
+    for (const Spring& sp : sim.topology().springs) CHECK((sp.a != lone && sp.b != lone));
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    REQUIRE(piece[lone] != piece[0]);
+    CHECK(piece_area(sim, v, piece[lone]) == Approx(kSpacing * kSpacing).epsilon(1e-5));
+    CHECK(piece_area(sim, v, piece[0]) == Approx(0.49 - kSpacing * kSpacing).epsilon(1e-5));
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: a tear pulled open keeps every triangle within one piece", "[tearing]") {
+    // The free sheet whose halves move apart (test_tearing.cpp): it tears down the middle.
+    Scene s;
+    s.cloth.rows = s.cloth.cols = 12;
+    s.pins.preset = PinPreset::None;
+    s.settings.forces.gravity = glm::vec3(0.0f);
+    s.settings.colliders.ground.enabled = false;
+    s.settings.springs.damping = 0.0f;
+    s.settings.springs.tear_strain = 0.2f;
+    s.settings.solver.sleep_speed = 0.0f;
+    MassSpring sim = build_simulation(s);
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const int col = static_cast<int>(i) % 12;
+        sim.set_particle(i, sim.position(i), glm::vec3(col < 6 ? -8.0f : 8.0f, 0.0f, 0.0f));
+    }
+    const std::uint64_t stamp = sim.topology_stamp();
+    sim.run_steps(40);
+    REQUIRE(sim.broken_springs() > 0);
+    CHECK(sim.topology_stamp() != stamp);
+    REQUIRE(sim.surface().split());
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    for (const glm::vec3& p : v) REQUIRE(std::isfinite(p.x + p.y + p.z));
+    check_surface_respects_the_tears(sim);
+    std::vector<glm::vec3> normals;
+    split_surface_normals(sim.surface(), v, normals);
+    REQUIRE(normals.size() == v.size());
+    for (const glm::vec3& n : normals) CHECK(glm::length(n) == Approx(1.0f).epsilon(1e-5));
+}

@@ -199,6 +199,7 @@ void pins_to_scene(AppState& app) {
     }
     app.scene.pins.preset = PinPreset::None;
     app.scene.pins.preset_radius = 0.0f;
+    if (soft.empty()) app.scene.pins.clip = ClipHold::Rigid;  // no clip left to hold softly (validate refuses it)
     app.scene.pins.particles = std::move(soft);
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
         if (app.sim.state().pinned[i] == kPinned) {

@@ -121,6 +121,7 @@ bool pin_combo(const std::string& label, PinSpec* v) {
             if (ImGui::Selectable(std::string(names[i]).c_str(), i == preset && v->particles.empty())) {
                 v->preset = static_cast<PinPreset>(i);
                 v->particles.clear();
+                if (v->preset_radius == 0.0f) v->clip = ClipHold::Rigid;  // no clip left to hold softly
                 edited = true;
             }
         }

@@ -8,6 +8,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <charconv>
@@ -284,6 +285,14 @@ void validate(const Scene& scene) {
         }
     };
     check_radius(scene.pins.preset_radius, "radius");
+    // A soft clip is a pin with a radius (ClipHold): "soft" with none would hold nothing softly, silently.
+    const bool any_clip = scene.pins.preset_radius > 0.0f ||
+                          std::any_of(scene.pins.particles.begin(), scene.pins.particles.end(),
+                                      [](const PinClip& pin) { return pin.radius > 0.0f; });
+    if (scene.pins.clip == ClipHold::Soft && !any_clip) {
+        throw SceneError("pins: clip = \"soft\" has no clip to hold softly: no pin has a radius; allowed with "
+                         "clip = \"soft\": pins.radius > 0 or a pin { particle = [row, col], radius = R } with R > 0");
+    }
     for (const PinClip& pin : scene.pins.particles) {
         const int r = pin.row, col = pin.col;
         check_radius(pin.radius, cat("the radius of the clip at [", std::to_string(r), ", ", std::to_string(col), "]"));

@@ -102,11 +102,15 @@ TEST_CASE("soft clip: each particle is held with k = kappa A (1 - (d/R)^2)^2, an
     CHECK(pinned == t.holds.size() + rim);
 }
 
-TEST_CASE("soft clip: a point pin stays pinned, and a soft clip's rim particle (weight 0) is not held", "[soft_clip]") {
+TEST_CASE("soft clip: a point pin stays pinned beside a clip, soft with no clip at all is refused, and a soft "
+          "clip's rim particle (weight 0) is not held", "[soft_clip]") {
     Scene s = clipped_sheet(11, 5, 5, 0.0f, ClipHold::Soft);
+    CHECK_THROWS_AS(build_simulation(s), SceneError);  // nothing to hold softly (scene_fields.cpp, validate)
+    s.pins.particles.push_back(PinClip{0, 0, 0.1f});
     MassSpring point = build_simulation(s);
-    CHECK(point.topology().holds.empty());
+    for (const Hold& hold : point.topology().holds) CHECK(hold.particle != 5 * 11 + 5);
     CHECK(point.state().pinned[5 * 11 + 5] == kPinned);
+    s.pins.particles.pop_back();
     // A radius of exactly two spacings: the particles two spacings away lie on the rim.
     s.pins.particles = {PinClip{5, 5, 0.2f}};
     const MassSpring clip = build_simulation(s);

@@ -1,12 +1,13 @@
 // The cloth's surface as drawn and exported once it has torn: the mesh split along the tear.
 //
 // Each particle stands for the patch of cloth around it, half a cell in every direction. An untorn cell is
-// drawn as its two triangles (Topology::triangles). A torn cell, one that lost a triangle to a broken spring
-// (tearing.hpp), is drawn instead as four quadrants, one per corner particle: the particle, the points of
-// the two cell edges it lies on, and the cell's centre. Where an edge's spring holds, its point is the
+// drawn as its two triangles (Topology::triangles). A torn cell, one built whole that lost a triangle to a
+// broken spring (tearing.hpp), is drawn instead as four quadrants, one per corner particle: the particle, the
+// points of the two cell edges it lies on, and the cell's centre. Where an edge's spring holds, its point is the
 // edge's middle, shared by both ends. Where it broke, each end has a point of its own (the vertex is split):
-// the end's half of the edge, which continues the end's own row or column beyond it, p + (p - back) / 2, or
-// when that neighbour is gone too, reaches half the rest length towards the other end. Corners of the cell
+// the end's half of the edge. It continues the end's own row or column beyond it, towards p + (p - back) / 2,
+// while that still points across the edge, else it points at the other end; it reaches no further than half
+// the rest length nor halfway to the other end, so the sides never overlap. Corners of the cell
 // still joined by a spring of the cell (structural or shear) share one centre, the mean of their quadrants'
 // parallelogram corners e_1 + e_2 - p; the pieces of a cell have one each. So a cut through a flat cloth
 // shows a clean seam where the two sides meet, a tear that opens shows a crack as wide as the pieces have
@@ -53,10 +54,16 @@ struct ClothSurface {
     std::size_t vertex_count() const { return particles + edge_points.size() + centres.size(); }
 };
 
-// The surface of `topology` (a grid; any other topology, or one with no torn cell, gives an unsplit surface).
-// `pinned` marks absent particles (kAbsent), `rest` holds the rest positions the rest lengths come from.
-ClothSurface build_cloth_surface(const Topology& topology, const std::vector<std::uint8_t>& pinned,
-                                 const DVec3Array& rest);
+// Per grid cell (row-major, (rows - 1) x (cols - 1)), 1 where the topology has both the builder's triangles of
+// the cell, (00, 01, 10) and (01, 11, 10); empty when it is not a grid of `particles`. Taken when the cloth is
+// built, it says which cells a tear can leave torn.
+std::vector<std::uint8_t> whole_cells(const Topology& topology, std::size_t particles);
+
+// The surface of `topology`: the cells whole at the start (whole_cells) that have lost a triangle are split.
+// Any other topology, or one with no torn cell, gives an unsplit surface. `rest` holds the rest positions the
+// rest lengths come from.
+ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest,
+                                 const std::vector<std::uint8_t>& whole_at_start);
 
 // Resizes `vertices`, which holds the particles' positions, to surface.vertex_count() and writes the split
 // vertices' positions after them.

@@ -16,19 +16,60 @@ std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
 
 }  // namespace
 
-ClothSurface build_cloth_surface(const Topology& topology, const std::vector<std::uint8_t>& pinned,
-                                 const DVec3Array& rest) {
+namespace {
+
+// Per grid cell, which of the builder's two triangles the topology has: 1 for (00, 01, 10), 2 for (01, 11, 10);
+// empty when the topology is not a grid of rows x cols particles.
+std::vector<std::uint8_t> drawn_cells(const Topology& topology, std::size_t particles) {
+    const int rows = topology.rows, cols = topology.cols;
+    if (rows < 2 || cols < 2 || particles != static_cast<std::size_t>(rows) * cols) return {};
+    std::vector<std::uint8_t> drawn(static_cast<std::size_t>(rows - 1) * (cols - 1), 0);
+    for (const auto& t : topology.triangles) {
+        std::array<std::uint32_t, 3> s = t;
+        std::sort(s.begin(), s.end());
+        // The smallest index is the cell's 00 in (00, 01, 10) and its 01 in (01, 11, 10).
+        const int r = static_cast<int>(s[0]) / cols, c = static_cast<int>(s[0]) % cols;
+        if (r + 1 >= rows) continue;
+        const auto at = [&](int dr, int dc) { return static_cast<std::uint32_t>(topology.index(r + dr, c + dc)); };
+        if (c + 1 < cols && s == std::array<std::uint32_t, 3>{at(0, 0), at(0, 1), at(1, 0)}) {
+            drawn[static_cast<std::size_t>(r) * (cols - 1) + c] |= 1;
+        } else if (c > 0 && s == std::array<std::uint32_t, 3>{at(0, 0), at(1, -1), at(1, 0)}) {
+            drawn[static_cast<std::size_t>(r) * (cols - 1) + c - 1] |= 2;
+        }
+    }
+    return drawn;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> whole_cells(const Topology& topology, std::size_t particles) {
+    std::vector<std::uint8_t> whole = drawn_cells(topology, particles);
+    for (std::uint8_t& cell : whole) cell = cell == 3 ? 1 : 0;
+    return whole;
+}
+
+ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest,
+                                 const std::vector<std::uint8_t>& whole_at_start) {
     ClothSurface surface;
     const int rows = topology.rows, cols = topology.cols;
     const std::size_t n = rest.size();
     surface.particles = n;
-    if (rows < 2 || cols < 2 || n != static_cast<std::size_t>(rows) * cols || pinned.size() != n) return surface;
+    const std::vector<std::uint8_t> drawn = drawn_cells(topology, n);
+    if (drawn.empty() || whole_at_start.size() != drawn.size()) return surface;
 
     auto id = [&](int r, int c) { return static_cast<std::uint32_t>(topology.index(r, c)); };
-    auto present = [&](int r, int c) { return pinned[topology.index(r, c)] != kAbsent; };
     auto row = [&](std::uint32_t v) { return static_cast<int>(v) / cols; };
     auto col = [&](std::uint32_t v) { return static_cast<int>(v) % cols; };
-    // The grid cell a triangle lies in (row and column of its corner 00), or -1 when it is no cell's.
+    // A torn cell: it had both its triangles when the cloth was built and has lost one since.
+    const std::size_t cells = drawn.size();
+    std::vector<std::uint8_t> torn_cell(cells, 0);
+    bool any = false;
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+        torn_cell[cell] = whole_at_start[cell] && drawn[cell] != 3;
+        any = any || torn_cell[cell];
+    }
+    if (!any) return surface;
+    // The grid cell a triangle lies in, or -1 when it is no cell's.
     auto cell_of = [&](const std::array<std::uint32_t, 3>& t) {
         int r0 = rows, c0 = cols, r1 = -1, c1 = -1;
         for (std::uint32_t v : t) {
@@ -36,28 +77,6 @@ ClothSurface build_cloth_surface(const Topology& topology, const std::vector<std
         }
         return r1 - r0 == 1 && c1 - c0 == 1 ? static_cast<std::ptrdiff_t>(r0) * (cols - 1) + c0 : -1;
     };
-    // Per cell, which of its two triangles are drawn: 1 for (00, 01, 10), 2 for (01, 11, 10).
-    const std::size_t cells = static_cast<std::size_t>(rows - 1) * (cols - 1);
-    std::vector<std::uint8_t> drawn(cells, 0);
-    for (const auto& t : topology.triangles) {
-        const std::ptrdiff_t cell = cell_of(t);
-        if (cell < 0) continue;
-        const std::uint32_t corner_00 = id(static_cast<int>(cell) / (cols - 1), static_cast<int>(cell) % (cols - 1));
-        const bool has_00 = t[0] == corner_00 || t[1] == corner_00 || t[2] == corner_00;
-        drawn[static_cast<std::size_t>(cell)] |= has_00 ? 1 : 2;
-    }
-    // A torn cell: all four corners belong to the cloth and a triangle of the cell is gone.
-    std::vector<std::uint8_t> torn_cell(cells, 0);
-    bool any = false;
-    for (int r = 0; r + 1 < rows; ++r) {
-        for (int c = 0; c + 1 < cols; ++c) {
-            const std::size_t cell = static_cast<std::size_t>(r) * (cols - 1) + c;
-            torn_cell[cell] = present(r, c) && present(r, c + 1) && present(r + 1, c) && present(r + 1, c + 1) &&
-                              drawn[cell] != 3;
-            any = any || torn_cell[cell];
-        }
-    }
-    if (!any) return surface;
 
     // Per particle, the structural and shear springs that still join it to the next row and column: bit 1
     // to (r, c + 1), 2 to (r + 1, c), 4 to (r + 1, c + 1), 8 to (r + 1, c - 1).
@@ -102,7 +121,7 @@ ClothSurface build_cloth_surface(const Topology& topology, const std::vector<std
         if (!whole) {
             // The particle on the other side of `from`, in line with the edge.
             const int rb = 2 * row(from) - row(to), cb = 2 * col(from) - col(to);
-            if (rb >= 0 && rb < rows && cb >= 0 && cb < cols && present(rb, cb) && holds(id(rb, cb), from)) {
+            if (rb >= 0 && rb < rows && cb >= 0 && cb < cols && holds(id(rb, cb), from)) {
                 e.back = id(rb, cb);
             }
         }
@@ -173,11 +192,18 @@ void place_split_vertices(const ClothSurface& surface, std::vector<glm::vec3>& v
         glm::vec3 point;
         if (e.whole) {
             point = 0.5f * (p + q);
-        } else if (e.back != ClothSurface::kNoParticle) {
-            point = p + 0.5f * (p - vertices[e.back]);
         } else {
-            const float length = glm::length(q - p);
-            point = length > 0.0f ? p + (std::min(0.5f * length, e.half_rest) / length) * (q - p) : p;
+            // The end's own row or column continued while it still points across the edge, else towards q; no
+            // further than half the rest length nor halfway to q, so the two sides never overlap.
+            const float gap = glm::length(q - p);
+            glm::vec3 direction = q - p;
+            float reach = std::min(0.5f * gap, e.half_rest);
+            if (e.back != ClothSurface::kNoParticle && glm::dot(p - vertices[e.back], q - p) > 0.0f) {
+                direction = p - vertices[e.back];
+                reach = std::min(0.5f * glm::length(direction), reach);
+            }
+            const float length = glm::length(direction);
+            point = length > 0.0f ? p + (reach / length) * direction : p;
         }
         vertices[first_edge + i] = point;
     }

@@ -22,15 +22,22 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
         out << "vt " << (t.cols > 1 ? grid.x / float(t.cols - 1) : 0.0f) << ' '
             << (t.rows > 1 ? 1.0f - grid.y / float(t.rows - 1) : 0.0f) << '\n';
     };
-    for (int r = 0; r < t.rows; ++r) {
-        for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
+    // UVs come from the grid: a topology that is not a grid of its particles is written without them.
+    const bool grid = static_cast<std::size_t>(t.rows) * static_cast<std::size_t>(t.cols) == sim.particle_count();
+    if (grid) {
+        for (int r = 0; r < t.rows; ++r) {
+            for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
+        }
+        for (const glm::vec2& place : surface.split_grid) uv(place);
     }
-    if (surface.split()) {
-        for (const glm::vec2& grid : surface.split_grid) uv(grid);
-    }
+    auto corner = [&](std::uint32_t v) {
+        out << ' ' << v + 1;
+        if (grid) out << '/' << v + 1;
+    };
     for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
-        out << "f " << tri[0] + 1 << '/' << tri[0] + 1 << ' ' << tri[1] + 1 << '/' << tri[1] + 1 << ' '
-            << tri[2] + 1 << '/' << tri[2] + 1 << '\n';
+        out << 'f';
+        for (std::uint32_t v : tri) corner(v);
+        out << '\n';
     }
     if (!write_file_atomically(path, out.str(), error)) {
         error = "OBJ file: " + error;

@@ -65,7 +65,8 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
     spacing_ = particle_spacing(topology_);
     tethers_ = build_tethers(topology_, state_, rest_position_);
-    surface_ = build_cloth_surface(topology_, state_.pinned, rest_position_);
+    whole_cells_ = whole_cells(topology_, n);
+    surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
     replan();
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
                                      : std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()),
@@ -320,7 +321,7 @@ void MassSpring::topology_changed(std::size_t removed) {
     iterative_.invalidate();
     if (self_collision_) self_collision_->update_neighbours(topology_, rest_position_);
     rebuild_tethers();
-    surface_ = build_cloth_surface(topology_, state_.pinned, rest_position_);
+    surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
     replan();
     setup_stamp_ = next_stamp();
     topology_stamp_ = next_stamp();

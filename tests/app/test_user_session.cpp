@@ -298,7 +298,7 @@ TEST_CASE("user session: shift + right-drag across the paused curtain cuts it, a
     CHECK_THAT(r.err, !Contains("guard"));
 }
 
-TEST_CASE("user session: a slit cut up into the paused curtain shows as a seam, not a gap; played on, it parts") {
+TEST_CASE("user session: a slit cut up into the paused curtain shows as a seam, not a gap, and the curtain plays on") {
     const clothsim::Scene scene = clothsim::load_scene("curtain");
     const int cols = scene.cloth.cols, rows = scene.cloth.rows;
     auto on_screen = [&](int row, int col) { return particle_on_screen(scene, static_cast<std::size_t>(row * cols + col)); };

@@ -3,13 +3,19 @@
 #include "support.hpp"
 
 #include "clothsim/cloth_surface.hpp"
+#include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/tearing.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 using namespace clothsim;
 
@@ -122,7 +128,104 @@ TEST_CASE("cloth surface: a straight cut through a flat cloth is a closed seam: 
         }
     }
     CHECK(pairs == kSide);  // one per column: the vertical springs the cut crossed
+    // The 7 torn cells of row 3: 8 x 2 ends of broken edges and 2 x 7 held edges' middles; two pieces each.
+    CHECK(s.edge_points.size() == 30);
+    CHECK(s.centres.size() == 14);
+    // Within a piece nothing is split: the only vertices that coincide belong to different pieces (the two
+    // ends of a broken edge, the centres of a torn cell's two pieces). A held edge's middle made twice, or a
+    // piece's corners each with a centre of their own, would coincide within one piece.
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        for (std::size_t j = i + 1; j < v.size(); ++j) {
+            if (glm::length(v[i] - v[j]) > 1e-6f) continue;
+            INFO("vertices " << i << " and " << j << " coincide");
+            CHECK(piece[i] != piece[j]);
+        }
+    }
     check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: each side of a cut continues its own columns, however the other side moved",
+          "[tearing]") {
+    MassSpring sim = flat_cloth();
+    REQUIRE(cut_between_rows_3_and_4(sim) > 0);
+    const glm::vec3 moved(0.05f, 0.02f, 0.05f);  // the lower piece: across, up and away
+    for (std::size_t i = 4 * kSide; i < sim.particle_count(); ++i) {
+        sim.set_particle(i, sim.position(i) + moved, glm::vec3(0.0f));
+    }
+    const ClothSurface& s = sim.surface();
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    std::size_t ends = 0;
+    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
+        const ClothSurface::EdgePoint& e = s.edge_points[i];
+        if (e.whole) continue;
+        ++ends;
+        // Half a spacing on along the column: +z below row 3, -z above row 4.
+        const float along = e.from < 4 * kSide ? 0.05f : -0.05f;
+        const glm::vec3 expected = sim.position(e.from) + glm::vec3(0.0f, 0.0f, along);
+        INFO("the point of particle " << e.from << " towards " << e.to);
+        CHECK(glm::length(v[s.particles + i] - expected) < 1e-6f);
+    }
+    CHECK(ends == 2 * kSide);
+}
+
+TEST_CASE("cloth surface: a torn cell whose four sides hold has its centre at the mean of its corners, on a "
+          "bent cloth", "[tearing]") {
+    MassSpring sim = flat_cloth();
+    // Bent out of its plane, not affinely: y = 1 + 0.3 x^2 + 0.2 x z.
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::vec3 p = sim.position(i);
+        sim.set_particle(i, {p.x, 1.0f + 0.3f * p.x * p.x + 0.2f * p.x * p.z, p.z}, glm::vec3(0.0f));
+    }
+    // Cut the one diagonal (01, 10) of cell (3, 3): both the cell's triangles have it as an edge.
+    const glm::vec3 a = sim.position(3 * kSide + 4), b = sim.position(4 * kSide + 3);
+    REQUIRE(sim.cut([&](glm::vec3 p, glm::vec3 q) { return (p == a && q == b) || (p == b && q == a); }) > 0);
+    const ClothSurface& s = sim.surface();
+    REQUIRE(s.split());
+    REQUIRE(s.centres.size() == 1);  // one piece: the four sides hold it together
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    const glm::vec3 mean = 0.25f * (sim.position(3 * kSide + 3) + sim.position(3 * kSide + 4) +
+                                    sim.position(4 * kSide + 3) + sim.position(4 * kSide + 4));
+    CHECK(glm::length(v[s.vertex_count() - 1] - mean) < 1e-6f);
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: a hand-made grid drawn without triangles stays so when a spring of it breaks",
+          "[tearing]") {
+    const MassSpring built = flat_cloth();
+    Topology t = built.topology();
+    t.triangles.clear();
+    t.cell_triangles = false;
+    MassSpring sim(t, built.state(), built.settings());
+    REQUIRE(cut_between_rows_3_and_4(sim) > 0);
+    CHECK_FALSE(sim.surface().split());  // no cell was whole to begin with: nothing is torn
+}
+
+TEST_CASE("cloth surface: the OBJ export of a topology that is no grid of its particles has faces without UVs",
+          "[tearing]") {
+    const MassSpring built = flat_cloth();
+    Topology t = built.topology();
+    t.rows = t.cols = 0;  // hand-made: the triangles stay, the grid is gone
+    const MassSpring sim(t, built.state(), built.settings());
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("clothsim-nogrid-" + std::to_string(::getpid()) + ".obj")).string();
+    std::string error;
+    REQUIRE(write_obj(sim, path, error));
+    std::ifstream in(path);
+    std::size_t faces = 0, uvs = 0, vertices = 0;
+    for (std::string line; std::getline(in, line);) {
+        vertices += line.rfind("v ", 0) == 0 ? 1 : 0;
+        uvs += line.rfind("vt ", 0) == 0 ? 1 : 0;
+        if (line.rfind("f ", 0) == 0) {
+            ++faces;
+            CHECK(line.find('/') == std::string::npos);  // no reference to a UV that is not written
+        }
+    }
+    in.close();
+    std::filesystem::remove(path);
+    CHECK(vertices == sim.particle_count());
+    CHECK(uvs == 0);
+    CHECK(faces == t.triangles.size());
 }
 
 TEST_CASE("cloth surface: an opened cut is a crack as wide as the pieces parted, each piece whole to the seam",

@@ -635,8 +635,13 @@ void stats_section(const AppState& app) {
     ImGui::Text("%.0f FPS (%.2f ms per frame)", io.Framerate, 1000.0f / std::max(io.Framerate, 1e-3f));
     ImGui::Text("simulation %.2f ms (%lld substeps), render %.2f ms", app.stats.sim_ms, app.stats.substeps_last_frame,
                 app.stats.render_ms);
-    ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
-                app.sim.time());
+    if (app.sim.broken_springs() > 0) {  // torn or cut: as --json's broken_springs
+        ImGui::Text("%zu particles, %zu springs (%zu broken), t = %.2f s", app.sim.particle_count(),
+                    app.sim.spring_count(), app.sim.broken_springs(), app.sim.time());
+    } else {
+        ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
+                    app.sim.time());
+    }
     // The fast path runs position Verlet (the fast solver) and XPBD (its grid form); every other integrator
     // uses the shared textbook force path.
     const bool fast = app.sim.last_step_fast();

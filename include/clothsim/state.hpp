@@ -63,7 +63,6 @@ struct Hold {
     float stiffness = 0.0f;  // N/m
     glm::dvec3 anchor{0.0};  // m
     float share_u = 0.0f, share_v = 0.0f;
-    float weight = 0.0f;  // w = (1 - (d/R)^2)^2 of its clip: 1 at the clip's own particle (tethers tie to it)
     float stiffness_for(const glm::vec2& structural) const {
         return std::max(structural.x * share_u, structural.y * share_v);
     }

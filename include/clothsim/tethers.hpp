@@ -11,10 +11,9 @@
 // tether_strain along the way, and stops it stretching more. A particle next to a pin is tied at exactly
 // its springs' rest length, so the springs at a pin stretch by tether_strain at most.
 //
-// Which pins: pinned particles joined by a spring form a cluster (a clip, a pinned row, one corner), and a
-// soft clip's own particle (Hold::weight 1, which its hold keeps nearest its place) is a cluster of its own.
-// Each free particle is tied to the nearest anchor of each of its kMaxTethersPerParticle nearest clusters
-// (by rest distance). The tethers are built when the cloth is and again whenever a pin is set or
+// Which pins: pinned particles joined by a spring form a cluster (a clip, a pinned row, one corner). Each
+// free particle is tied to the nearest pinned particle of each of its kMaxTethersPerParticle nearest
+// clusters (by rest distance). The tethers are built when the cloth is and again whenever a pin is set or
 // freed (MassSpring::set_pinned); a pin moved by move_pinned keeps its tethers and they follow it.
 #pragma once
 
@@ -42,7 +41,7 @@ struct Tethers {
 Tethers build_tethers(const Topology& topology, const State& state, const DVec3Array& rest);
 
 // Every particle farther than (1 + strain) L from an anchor is moved back onto that sphere, radially, and
-// its motion away from the anchor is removed (the anchor is pinned, or held by a soft clip, and is not moved): a tether at its
+// its motion away from the anchor is removed (the anchor is pinned and does not move): a tether at its
 // limit stops the particle stretching it, and like a collision push it adds no velocity of its own, so it
 // never adds energy. One pass in tether order; returns how many tethers were at their limit.
 std::size_t project_tethers(State& state, const Tethers& tethers, double strain);

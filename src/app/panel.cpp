@@ -121,14 +121,16 @@ bool pin_combo(const std::string& label, PinSpec* v) {
             if (ImGui::Selectable(std::string(names[i]).c_str(), i == preset && v->particles.empty())) {
                 v->preset = static_cast<PinPreset>(i);
                 v->particles.clear();
-                if (v->preset_radius == 0.0f) v->clip = ClipHold::Rigid;  // no clip left to hold softly
+                if (v->preset == PinPreset::None || v->preset_radius == 0.0f) {
+                    v->clip = ClipHold::Rigid;  // no clip left to hold softly
+                }
                 edited = true;
             }
         }
         ImGui::Separator();
         // Only clips (pins with a radius) can be soft; point pins stay rigid, so without a clip the switch is
         // shown but cannot be used.
-        const bool clips = v->preset_radius > 0.0f ||
+        const bool clips = (v->preset != PinPreset::None && v->preset_radius > 0.0f) ||
                            std::any_of(v->particles.begin(), v->particles.end(), [](const PinClip& p) { return p.radius > 0.0f; });
         bool soft = v->clip == ClipHold::Soft;
         ImGui::BeginDisabled(!clips && !soft);

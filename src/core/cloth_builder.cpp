@@ -246,8 +246,7 @@ MassSpring build_simulation(const Scene& scene) {
         const double radius = std::max(w.radius, spacing);
         const double share = kClipHoldFactor / (radius * radius) * (0.25 * cells * cell_area) * w.weight;
         Hold hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
-                  static_cast<float>(share * aspect), static_cast<float>(share / aspect),
-                  static_cast<float>(w.weight)};
+                  static_cast<float>(share * aspect), static_cast<float>(share / aspect)};
         hold.stiffness = hold.stiffness_for(derived.settings.springs.structural);
         if (share > 0.0) topology.holds.push_back(hold);  // kept at k = 0 too: the springs may be raised later
     }

@@ -286,7 +286,7 @@ void validate(const Scene& scene) {
     };
     check_radius(scene.pins.preset_radius, "radius");
     // A soft clip is a pin with a radius (ClipHold): "soft" with none would hold nothing softly, silently.
-    const bool any_clip = scene.pins.preset_radius > 0.0f ||
+    const bool any_clip = (scene.pins.preset != PinPreset::None && scene.pins.preset_radius > 0.0f) ||
                           std::any_of(scene.pins.particles.begin(), scene.pins.particles.end(),
                                       [](const PinClip& pin) { return pin.radius > 0.0f; });
     if (scene.pins.clip == ClipHold::Soft && !any_clip) {

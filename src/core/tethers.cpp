@@ -31,14 +31,10 @@ Tethers build_tethers(const Topology& topology, const State& state, const DVec3A
     for (const Spring& s : topology.springs) {
         if (state.pinned[s.a] == kPinned && state.pinned[s.b] == kPinned) clusters.join(s.a, s.b);
     }
-    // Each cluster's members, clusters in order of their root. A soft clip's own particle (weight 1) is a
-    // cluster of its own: it moves only as far as its hold gives, and the particles around it hang from it.
+    // Each cluster's members, clusters in order of their root.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> members;  // (root, particle)
     for (std::uint32_t i = 0; i < n; ++i) {
         if (state.pinned[i] == kPinned) members.emplace_back(clusters.find(i), i);
-    }
-    for (const Hold& h : topology.holds) {
-        if (h.weight == 1.0f && state.pinned[h.particle] == 0) members.emplace_back(h.particle, h.particle);
     }
     std::sort(members.begin(), members.end());
     std::vector<std::size_t> begin;  // cluster c is members[begin[c], begin[c + 1])
@@ -53,19 +49,15 @@ Tethers build_tethers(const Topology& topology, const State& state, const DVec3A
     for (std::uint32_t i = 0; i < n && cluster_count > 0; ++i) {
         if (state.pinned[i] != 0) continue;  // pinned, or absent
         const glm::dvec3 p = rest.get(i);
-        std::size_t candidates = 0;
         for (std::size_t c = 0; c < cluster_count; ++c) {
-            if (members[begin[c]].second == i) continue;  // a soft clip's particle is no anchor of itself
-            auto& best = nearest[candidates++];
-            best = {std::numeric_limits<double>::infinity(), 0u};
+            nearest[c] = {std::numeric_limits<double>::infinity(), 0u};
             for (std::size_t k = begin[c]; k < begin[c + 1]; ++k) {
                 const std::uint32_t a = members[k].second;
-                best = std::min(best, {glm::length(rest.get(a) - p), a});
+                nearest[c] = std::min(nearest[c], {glm::length(rest.get(a) - p), a});
             }
         }
-        const std::size_t kept = std::min<std::size_t>(candidates, kMaxTethersPerParticle);
-        std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(kept),
-                          nearest.begin() + static_cast<std::ptrdiff_t>(candidates));
+        const std::size_t kept = std::min<std::size_t>(cluster_count, kMaxTethersPerParticle);
+        std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(kept), nearest.end());
         // Farthest first: when pins moved apart ask for more than the cloth can give (a pin dragged away from
         // the others), the nearest pin's tether is projected last and wins, so the cloth next to a dragged
         // pin follows it.

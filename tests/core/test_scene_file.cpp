@@ -792,7 +792,8 @@ TEST_CASE("scene pins: a bad clip is rejected with its line, the part at fault a
                Contains("pins.clip = 0.1 is not a clip kind; allowed: rigid, soft"));
     // Soft with no clip to hold softly (point pins stay rigid): refused, saying what soft needs.
     for (const char* pins : {"pins = { preset = \"top-corners\", clip = \"soft\" }\n",
-                             "pins = { particles = [[0, 0], [0, 3]], clip = \"soft\" }\n"}) {
+                             "pins = { particles = [[0, 0], [0, 3]], clip = \"soft\" }\n",
+                             "pins = { radius = 0.15, clip = \"soft\" }\n"}) {  // a radius, but no preset pin
         CHECK_THAT(parse_error(pins), Contains("pins: clip = \"soft\" has no clip to hold softly: no pin has a radius; "
                                                "allowed with clip = \"soft\": pins.radius > 0"));
     }

@@ -61,6 +61,26 @@ void edit_settings(clothsim::MassSpring& sim, Edit edit) {
     sim.apply(settings);
 }
 
+// A free 12 x 12 sheet in zero gravity, undamped, tearing beyond 20% strain, whose left half moves left and
+// right half moves right at `speed` (m/s): it tears down the middle.
+inline MassSpring pulled_apart(SolverMethod method, float speed) {
+    Scene s;
+    s.cloth.rows = s.cloth.cols = 12;
+    s.pins.preset = PinPreset::None;
+    s.settings.forces.gravity = glm::vec3(0.0f);
+    s.settings.colliders.ground.enabled = false;
+    s.settings.springs.damping = 0.0f;
+    s.settings.springs.tear_strain = 0.2f;
+    s.settings.solver.method = method;
+    s.settings.solver.sleep_speed = 0.0f;
+    MassSpring sim = build_simulation(s);
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const int col = static_cast<int>(i) % 12;
+        sim.set_particle(i, sim.position(i), glm::vec3(col < 6 ? -speed : speed, 0.0f, 0.0f));
+    }
+    return sim;
+}
+
 // A Cusick specimen: a 30 cm disc of n x n grid particles lying flat at y = 1, centred on the y axis,
 // nothing pinned, ground off.
 inline Scene disc_specimen(int n) {

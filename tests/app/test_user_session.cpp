@@ -48,6 +48,19 @@ bool orange_near(const Image& image, glm::vec3 screen, int radius) {
     return colour_near(image, screen, radius, is_hold_orange);
 }
 
+// Whether untextured cloth (salmon: red well above blue; the ground and the sky are grey or blue) covers
+// nearly all of the 5 x 5 pixels around `p`.
+bool cloth_at(const Image& image, glm::vec3 p) {
+    int cloth = 0;
+    for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+            const Rgb c = image.at(int(p.x) + dx, int(p.y) + dy);
+            cloth += c.r - c.b > 40 ? 1 : 0;
+        }
+    }
+    return cloth > 20;  // of 25 pixels
+}
+
 // Where the app's start camera shows particle `i` of `scene`'s initial cloth.
 glm::vec3 particle_on_screen(const clothsim::Scene& scene, std::size_t i) {
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
@@ -272,25 +285,13 @@ TEST_CASE("user session: shift + right-drag across the paused curtain cuts it, a
     const TempDir dir("session_cut");
     const RunResult r = run_user_session(
         dir, {"--scene", "curtain", "--paused", "--view", "no-texture"},
-        "shot before.png\ncut " + std::to_string(int(left.x) - 30) + " " + std::to_string(int(left.y)) + " " +
-            std::to_string(int(right.x) + 30) + " " + std::to_string(int(right.y)) +
-            "\nkey space\nsleep 2\nshot after.png\nquit\n");
+        "shot before.png\ncut " + at_xy(left - glm::vec3(30.0f, 0.0f, 0.0f)) + " " +
+            at_xy(right + glm::vec3(30.0f, 0.0f, 0.0f)) + "\nkey space\nsleep 2\nshot after.png\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     const Image before = load_png(dir / "before.png"), after = load_png(dir / "after.png");
     REQUIRE(before.width == kWidth);
     REQUIRE(after.width == kWidth);
-    // Untextured, the cloth is salmon (red well above blue); the ground and the sky are grey or blue.
-    auto cloth_at = [](const Image& image, glm::vec3 p) {
-        int cloth = 0;
-        for (int dy = -2; dy <= 2; ++dy) {
-            for (int dx = -2; dx <= 2; ++dx) {
-                const Rgb c = image.at(int(p.x) + dx, int(p.y) + dy);
-                cloth += c.r - c.b > 40 ? 1 : 0;
-            }
-        }
-        return cloth > 20;  // of 25 pixels
-    };
     CHECK(cloth_at(before, below));
     CHECK(cloth_at(before, above));
     CHECK_FALSE(cloth_at(after, below));  // the part below the cut fell away
@@ -309,24 +310,13 @@ TEST_CASE("user session: a slit cut up into the paused curtain shows as a seam, 
     const TempDir dir("session_slit");
     const RunResult r = run_user_session(
         dir, {"--scene", "curtain", "--paused", "--view", "no-texture"},
-        "cut " + std::to_string(int(bottom.x)) + " " + std::to_string(int(bottom.y) + 30) + " " +
-            std::to_string(int(top.x)) + " " + std::to_string(int(top.y)) +
+        "cut " + at_xy(bottom + glm::vec3(0.0f, 30.0f, 0.0f)) + " " + at_xy(top) +
             "\nshot cut.png\nkey space\nsleep 2\nshot played.png\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
     const Image cut = load_png(dir / "cut.png"), played = load_png(dir / "played.png");
     REQUIRE(cut.width == kWidth);
     REQUIRE(played.width == kWidth);
-    auto cloth_at = [](const Image& image, glm::vec3 p) {  // untextured cloth is salmon: red well above blue
-        int cloth = 0;
-        for (int dy = -2; dy <= 2; ++dy) {
-            for (int dx = -2; dx <= 2; ++dx) {
-                const Rgb c = image.at(int(p.x) + dx, int(p.y) + dy);
-                cloth += c.r - c.b > 40 ? 1 : 0;
-            }
-        }
-        return cloth > 20;  // of 25 pixels
-    };
     // Paused, the cut cloth has not moved: its two sides meet along the seam. Drawn without the split
     // (the torn cells' triangles dropped), a column of cells about 11 px wide would show the sky there.
     for (int row = 24; row < rows - 1; row += 3) {

@@ -269,20 +269,7 @@ TEST_CASE("cloth surface: a particle cut free keeps its own patch, one cell of c
 }
 
 TEST_CASE("cloth surface: a tear pulled open keeps every triangle within one piece", "[tearing]") {
-    // The free sheet whose halves move apart (test_tearing.cpp): it tears down the middle.
-    Scene s;
-    s.cloth.rows = s.cloth.cols = 12;
-    s.pins.preset = PinPreset::None;
-    s.settings.forces.gravity = glm::vec3(0.0f);
-    s.settings.colliders.ground.enabled = false;
-    s.settings.springs.damping = 0.0f;
-    s.settings.springs.tear_strain = 0.2f;
-    s.settings.solver.sleep_speed = 0.0f;
-    MassSpring sim = build_simulation(s);
-    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-        const int col = static_cast<int>(i) % 12;
-        sim.set_particle(i, sim.position(i), glm::vec3(col < 6 ? -8.0f : 8.0f, 0.0f, 0.0f));
-    }
+    MassSpring sim = test::pulled_apart(SolverMethod::Fast, 8.0f);  // it tears down the middle
     const std::uint64_t stamp = sim.topology_stamp();
     sim.run_steps(40);
     REQUIRE(sim.broken_springs() > 0);

@@ -28,25 +28,6 @@ bool has_spring(const Topology& t, std::uint32_t a, std::uint32_t b) {
     return false;
 }
 
-// A free 12 x 12 sheet in zero gravity whose left half moves left and right half moves right: it tears
-// down the middle.
-MassSpring pulled_apart(SolverMethod method, float speed) {
-    Scene s;
-    s.cloth.rows = s.cloth.cols = 12;
-    s.pins.preset = PinPreset::None;
-    s.settings.forces.gravity = glm::vec3(0.0f);
-    s.settings.colliders.ground.enabled = false;
-    s.settings.springs.damping = 0.0f;
-    s.settings.springs.tear_strain = 0.2f;
-    s.settings.solver.method = method;
-    s.settings.solver.sleep_speed = 0.0f;
-    MassSpring sim = build_simulation(s);
-    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-        const int col = static_cast<int>(i) % 12;
-        sim.set_particle(i, sim.position(i), glm::vec3(col < 6 ? -speed : speed, 0.0f, 0.0f));
-    }
-    return sim;
-}
 
 }  // namespace
 
@@ -81,7 +62,7 @@ TEST_CASE("tearing: a hanging chain breaks at its top spring, which carries the 
 }
 
 TEST_CASE("tearing: momentum is kept and the energy never rises at a tear", "[tearing]") {
-    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    MassSpring sim = test::pulled_apart(SolverMethod::Fast, 8.0f);
     const double e0 = sim.energy().total();
     const glm::vec3 p0 = sim.momentum();
     REQUIRE(glm::length(p0) < 1e-6f);
@@ -110,8 +91,8 @@ TEST_CASE("tearing: momentum is kept and the energy never rises at a tear", "[te
 }
 
 TEST_CASE("tearing: the fast solver tears exactly as the textbook solver", "[tearing]") {
-    MassSpring fast = pulled_apart(SolverMethod::Fast, 8.0f);
-    MassSpring textbook = pulled_apart(SolverMethod::Textbook, 8.0f);
+    MassSpring fast = test::pulled_apart(SolverMethod::Fast, 8.0f);
+    MassSpring textbook = test::pulled_apart(SolverMethod::Textbook, 8.0f);
     for (int step = 0; step < 40; ++step) {
         fast.run_steps(1);
         textbook.run_steps(1);
@@ -123,7 +104,7 @@ TEST_CASE("tearing: the fast solver tears exactly as the textbook solver", "[tea
 }
 
 TEST_CASE("tearing: no triangle spans a torn spring, in the topology and in the OBJ export of the split surface", "[tearing]") {
-    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    MassSpring sim = test::pulled_apart(SolverMethod::Fast, 8.0f);
     const std::size_t triangles = sim.topology().triangles.size();
     sim.run_steps(40);
     REQUIRE(sim.broken_springs() > 0);
@@ -165,7 +146,7 @@ TEST_CASE("tearing: no triangle spans a torn spring, in the topology and in the 
 }
 
 TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {
-    MassSpring sim = pulled_apart(SolverMethod::Fast, 8.0f);
+    MassSpring sim = test::pulled_apart(SolverMethod::Fast, 8.0f);
     test::edit_settings(sim, [](SimulationSettings& s) { s.springs.tear_strain = 0.0f; });
     CHECK_FALSE(sim.plan().tear);
     sim.run_steps(40);

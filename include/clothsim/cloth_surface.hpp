@@ -65,6 +65,10 @@ std::vector<std::uint8_t> whole_cells(const Topology& topology, std::size_t part
 ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest,
                                  const std::vector<std::uint8_t>& whole_at_start);
 
+// The texture coordinate of a place on the grid, (column, row): u from 0 at column 0 to 1 at the last, v from 1
+// at row 0 to 0 at the last. Particles and split vertices (ClothSurface::split_grid) alike.
+glm::vec2 grid_uv(const Topology& topology, glm::vec2 grid);
+
 // Resizes `vertices`, which holds the particles' positions, to surface.vertex_count() and writes the split
 // vertices' positions after them.
 void place_split_vertices(const ClothSurface& surface, std::vector<glm::vec3>& vertices);

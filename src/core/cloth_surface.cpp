@@ -13,29 +13,37 @@ std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
     return (static_cast<std::uint64_t>(a) << 32) | b;
 }
 
+// The grid cell (row-major over (rows - 1) x (cols - 1)) of which `t` is one of the builder's two triangles,
+// with `which` = 1 for (00, 01, 10) and 2 for (01, 11, 10); -1 for any other triangle.
+std::ptrdiff_t builder_cell(const Topology& topology, const std::array<std::uint32_t, 3>& t, int& which) {
+    const int rows = topology.rows, cols = topology.cols;
+    std::array<std::uint32_t, 3> s = t;
+    std::sort(s.begin(), s.end());
+    // The smallest index is the cell's 00 in (00, 01, 10) and its 01 in (01, 11, 10).
+    const int r = static_cast<int>(s[0]) / cols, c = static_cast<int>(s[0]) % cols;
+    if (r + 1 >= rows) return -1;
+    const auto at = [&](int dr, int dc) { return static_cast<std::uint32_t>(topology.index(r + dr, c + dc)); };
+    if (c + 1 < cols && s == std::array<std::uint32_t, 3>{at(0, 0), at(0, 1), at(1, 0)}) {
+        which = 1;
+        return static_cast<std::ptrdiff_t>(r) * (cols - 1) + c;
+    }
+    if (c > 0 && s == std::array<std::uint32_t, 3>{at(0, 0), at(1, -1), at(1, 0)}) {
+        which = 2;
+        return static_cast<std::ptrdiff_t>(r) * (cols - 1) + c - 1;
+    }
+    return -1;
+}
 
-}  // namespace
-
-namespace {
-
-// Per grid cell, which of the builder's two triangles the topology has: 1 for (00, 01, 10), 2 for (01, 11, 10);
+// Per grid cell, which of the builder's two triangles the topology has (the bits of builder_cell's `which`);
 // empty when the topology is not a grid of rows x cols particles.
 std::vector<std::uint8_t> drawn_cells(const Topology& topology, std::size_t particles) {
     const int rows = topology.rows, cols = topology.cols;
     if (rows < 2 || cols < 2 || particles != static_cast<std::size_t>(rows) * cols) return {};
     std::vector<std::uint8_t> drawn(static_cast<std::size_t>(rows - 1) * (cols - 1), 0);
     for (const auto& t : topology.triangles) {
-        std::array<std::uint32_t, 3> s = t;
-        std::sort(s.begin(), s.end());
-        // The smallest index is the cell's 00 in (00, 01, 10) and its 01 in (01, 11, 10).
-        const int r = static_cast<int>(s[0]) / cols, c = static_cast<int>(s[0]) % cols;
-        if (r + 1 >= rows) continue;
-        const auto at = [&](int dr, int dc) { return static_cast<std::uint32_t>(topology.index(r + dr, c + dc)); };
-        if (c + 1 < cols && s == std::array<std::uint32_t, 3>{at(0, 0), at(0, 1), at(1, 0)}) {
-            drawn[static_cast<std::size_t>(r) * (cols - 1) + c] |= 1;
-        } else if (c > 0 && s == std::array<std::uint32_t, 3>{at(0, 0), at(1, -1), at(1, 0)}) {
-            drawn[static_cast<std::size_t>(r) * (cols - 1) + c - 1] |= 2;
-        }
+        int which = 0;
+        const std::ptrdiff_t cell = builder_cell(topology, t, which);
+        if (cell >= 0) drawn[static_cast<std::size_t>(cell)] |= static_cast<std::uint8_t>(which);
     }
     return drawn;
 }
@@ -69,14 +77,6 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
         any = any || torn_cell[cell];
     }
     if (!any) return surface;
-    // The grid cell a triangle lies in, or -1 when it is no cell's.
-    auto cell_of = [&](const std::array<std::uint32_t, 3>& t) {
-        int r0 = rows, c0 = cols, r1 = -1, c1 = -1;
-        for (std::uint32_t v : t) {
-            r0 = std::min(r0, row(v)), r1 = std::max(r1, row(v)), c0 = std::min(c0, col(v)), c1 = std::max(c1, col(v));
-        }
-        return r1 - r0 == 1 && c1 - c0 == 1 ? static_cast<std::ptrdiff_t>(r0) * (cols - 1) + c0 : -1;
-    };
 
     // Per particle, the structural and shear springs that still join it to the next row and column: bit 1
     // to (r, c + 1), 2 to (r + 1, c), 4 to (r + 1, c + 1), 8 to (r + 1, c - 1).
@@ -100,7 +100,8 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
 
     // The triangles of untorn cells and of anything that is not a cell's, as the topology has them.
     for (const auto& t : topology.triangles) {
-        const std::ptrdiff_t cell = cell_of(t);
+        int which = 0;
+        const std::ptrdiff_t cell = builder_cell(topology, t, which);
         if (cell < 0 || !torn_cell[static_cast<std::size_t>(cell)]) surface.triangles.push_back(t);
     }
 
@@ -181,6 +182,11 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
         }
     });
     return surface;
+}
+
+glm::vec2 grid_uv(const Topology& topology, glm::vec2 grid) {
+    return {topology.cols > 1 ? grid.x / float(topology.cols - 1) : 0.0f,
+            topology.rows > 1 ? 1.0f - grid.y / float(topology.rows - 1) : 0.0f};
 }
 
 void place_split_vertices(const ClothSurface& surface, std::vector<glm::vec3>& vertices) {

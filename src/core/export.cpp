@@ -19,8 +19,8 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
     if (surface.split()) place_split_vertices(surface, vertices);
     for (const glm::vec3& p : vertices) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     auto uv = [&](glm::vec2 grid) {  // grid: (column, row)
-        out << "vt " << (t.cols > 1 ? grid.x / float(t.cols - 1) : 0.0f) << ' '
-            << (t.rows > 1 ? 1.0f - grid.y / float(t.rows - 1) : 0.0f) << '\n';
+        const glm::vec2 texture = grid_uv(t, grid);
+        out << "vt " << texture.x << ' ' << texture.y << '\n';
     };
     // UVs come from the grid: a topology that is not a grid of its particles is written without them.
     const bool grid = static_cast<std::size_t>(t.rows) * static_cast<std::size_t>(t.cols) == sim.particle_count();

@@ -168,14 +168,10 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
         MeshData data;
         data.positions = vertices;
         data.normals = normals_;
-        auto uv = [&](glm::vec2 grid) {  // grid: (column, row)
-            data.uvs.emplace_back(t.cols > 1 ? grid.x / float(t.cols - 1) : 0.0f,
-                                  t.rows > 1 ? 1.0f - grid.y / float(t.rows - 1) : 0.0f);
-        };
         for (int r = 0; r < t.rows; ++r) {
-            for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
+            for (int c = 0; c < t.cols; ++c) data.uvs.push_back(grid_uv(t, glm::vec2(float(c), float(r))));
         }
-        for (const glm::vec2& grid : surface.split_grid) uv(grid);
+        for (const glm::vec2& grid : surface.split_grid) data.uvs.push_back(grid_uv(t, grid));
         for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
             data.indices.insert(data.indices.end(), tri.begin(), tri.end());
         }

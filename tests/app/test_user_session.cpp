@@ -61,6 +61,17 @@ bool cloth_at(const Image& image, glm::vec3 p) {
     return cloth > 20;  // of 25 pixels
 }
 
+// The first frame of `flag` started paused with `--set set`, as the user sees it (an F12 screenshot).
+Image paused_flag_start(const std::string& name, const std::string& set) {
+    const TempDir dir(name);
+    const RunResult r = run_user_session(dir, {"--scene", "flag", "--set", set, "--paused"}, "shot start.png\nquit\n");
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    Image image = load_png(dir / "start.png");
+    REQUIRE(image.width == kWidth);
+    return image;
+}
+
 // Where the app's start camera shows particle `i` of `scene`'s initial cloth.
 glm::vec3 particle_on_screen(const clothsim::Scene& scene, std::size_t i) {
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
@@ -139,13 +150,7 @@ TEST_CASE("user session: every particle a clip holds shows a pin marker, the fre
     clothsim::apply_override(scene, clips);
     const std::vector<std::size_t> pins = pinned_particles(scene);
     REQUIRE(pins.size() == 24 + 37);
-    const TempDir dir("session_clip_markers");
-    const RunResult r =
-        run_user_session(dir, {"--scene", "flag", "--set", clips, "--paused"}, "shot start.png\nquit\n");
-    CAPTURE_RUN(r);
-    REQUIRE(r.code == 0);
-    const Image image = load_png(dir / "start.png");
-    REQUIRE(image.width == kWidth);
+    const Image image = paused_flag_start("session_clip_markers", clips);
     for (std::size_t pin : pins) {
         INFO("pin " << pin);
         CHECK(red_near(image, particle_on_screen(scene, pin), 3));
@@ -162,13 +167,7 @@ TEST_CASE("user session: a soft clip's particles show orange hold markers, not p
     clothsim::apply_override(scene, clips);
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
     REQUIRE(sim.topology().holds.size() > 20);
-    const TempDir dir("session_soft_clip_markers");
-    const RunResult r =
-        run_user_session(dir, {"--scene", "flag", "--set", clips, "--paused"}, "shot start.png\nquit\n");
-    CAPTURE_RUN(r);
-    REQUIRE(r.code == 0);
-    const Image image = load_png(dir / "start.png");
-    REQUIRE(image.width == kWidth);
+    const Image image = paused_flag_start("session_soft_clip_markers", clips);
     for (const clothsim::Hold& hold : sim.topology().holds) {
         INFO("held " << hold.particle);
         CHECK(orange_near(image, particle_on_screen(scene, hold.particle), 2));

@@ -232,53 +232,6 @@ MotionBounds reduce_lanes(const double* lanes) {
     return b;
 }
 
-__attribute__((target("avx512f,avx512vl,avx2,fma"))) void widen_avx512(const double* m, int n, double* lo,
-                                                                       double* hi) {
-    // maskz with all lanes: the unmasked forms trip GCC 12's -Wuninitialized in its header. Four running
-    // bounds, joined at the end: one would make every vector wait for the last one's min and max.
-    __m512d l0 = _mm512_load_pd(lo), h0 = _mm512_load_pd(hi);
-    __m512d l1 = l0, l2 = l0, l3 = l0, h1 = h0, h2 = h0, h3 = h0;
-    int c = 0;
-    for (; c + 32 <= n; c += 32) {
-        const __m512d a = _mm512_loadu_pd(m + c), b = _mm512_loadu_pd(m + c + 8);
-        const __m512d d = _mm512_loadu_pd(m + c + 16), e = _mm512_loadu_pd(m + c + 24);
-        l0 = _mm512_maskz_min_pd(0xFF, l0, a), h0 = _mm512_maskz_max_pd(0xFF, h0, a);
-        l1 = _mm512_maskz_min_pd(0xFF, l1, b), h1 = _mm512_maskz_max_pd(0xFF, h1, b);
-        l2 = _mm512_maskz_min_pd(0xFF, l2, d), h2 = _mm512_maskz_max_pd(0xFF, h2, d);
-        l3 = _mm512_maskz_min_pd(0xFF, l3, e), h3 = _mm512_maskz_max_pd(0xFF, h3, e);
-    }
-    for (; c + 8 <= n; c += 8) {
-        const __m512d v = _mm512_loadu_pd(m + c);
-        l0 = _mm512_maskz_min_pd(0xFF, l0, v), h0 = _mm512_maskz_max_pd(0xFF, h0, v);
-    }
-    l0 = _mm512_maskz_min_pd(0xFF, _mm512_maskz_min_pd(0xFF, l0, l1), _mm512_maskz_min_pd(0xFF, l2, l3));
-    h0 = _mm512_maskz_max_pd(0xFF, _mm512_maskz_max_pd(0xFF, h0, h1), _mm512_maskz_max_pd(0xFF, h2, h3));
-    _mm512_store_pd(lo, l0), _mm512_store_pd(hi, h0);
-    widen_tail(m, c, n, lo, hi);
-}
-__attribute__((target("avx2,fma"))) void widen_avx2(const double* m, int n, double* lo, double* hi) {
-    // Lanes 0-3 and 4-7, each with two running bounds (columns c and c + 8), joined at the end.
-    __m256d l0 = _mm256_load_pd(lo), l1 = _mm256_load_pd(lo + 4), h0 = _mm256_load_pd(hi), h1 = _mm256_load_pd(hi + 4);
-    __m256d l2 = l0, l3 = l1, h2 = h0, h3 = h1;
-    int c = 0;
-    for (; c + 16 <= n; c += 16) {
-        const __m256d a = _mm256_loadu_pd(m + c), b = _mm256_loadu_pd(m + c + 4);
-        const __m256d d = _mm256_loadu_pd(m + c + 8), e = _mm256_loadu_pd(m + c + 12);
-        l0 = _mm256_min_pd(l0, a), h0 = _mm256_max_pd(h0, a);
-        l1 = _mm256_min_pd(l1, b), h1 = _mm256_max_pd(h1, b);
-        l2 = _mm256_min_pd(l2, d), h2 = _mm256_max_pd(h2, d);
-        l3 = _mm256_min_pd(l3, e), h3 = _mm256_max_pd(h3, e);
-    }
-    for (; c + 8 <= n; c += 8) {
-        const __m256d a = _mm256_loadu_pd(m + c), b = _mm256_loadu_pd(m + c + 4);
-        l0 = _mm256_min_pd(l0, a), h0 = _mm256_max_pd(h0, a);
-        l1 = _mm256_min_pd(l1, b), h1 = _mm256_max_pd(h1, b);
-    }
-    l0 = _mm256_min_pd(l0, l2), l1 = _mm256_min_pd(l1, l3), h0 = _mm256_max_pd(h0, h2), h1 = _mm256_max_pd(h1, h3);
-    _mm256_store_pd(lo, l0), _mm256_store_pd(lo + 4, l1), _mm256_store_pd(hi, h0), _mm256_store_pd(hi + 4, h1);
-    widen_tail(m, c, n, lo, hi);
-}
-
 // Asked of the CPU once, on first use.
 FastKernel cpu_best_kernel() {
     static const FastKernel best = [] {
@@ -489,7 +442,6 @@ struct Grid {
 constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
 
 // Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
-// Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
 template <FastKernel K, unsigned Mask>
 [[gnu::always_inline]] inline void spring_row_body(const Grid& grid, const State& state, const SpringSettings& springs,
                                                    int r, float* out) {
@@ -542,28 +494,50 @@ template <FastKernel K, unsigned Mask>
     }
 }
 
-template <unsigned Mask, bool Ext>
-[[gnu::always_inline]] inline float row_force(const float* __restrict f0, const float* __restrict f1,
-                                              const float* __restrict f2, const float* __restrict ext,
-                                              std::size_t D, int c) {
-    float f = 0.0f;
+// Sixteen floats and eight doubles in GCC's vector extensions: each instruction set's sweep compiles them to
+// its own vectors (one 512-bit register, two 256-bit or four 128-bit ones), element-wise IEEE operations
+// without contraction (-ffp-contract=off), so a lane computes what the scalar loop computes.
+// Every function that takes or returns them is inlined into one sweep, so no call passes them across the
+// ABI that -Wpsabi warns about (the generic sweep's 512-bit vectors without AVX-512).
+#pragma GCC diagnostic ignored "-Wpsabi"
+using Floats16 = float __attribute__((vector_size(64)));
+using Floats8 = float __attribute__((vector_size(32)));
+using Doubles4 = double __attribute__((vector_size(32)));
+using Doubles8 = double __attribute__((vector_size(64)));
+using Doubles16 = double __attribute__((vector_size(128)));
+template <class V, class T>
+[[gnu::always_inline]] inline V load(const T* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V, class T>
+[[gnu::always_inline]] inline void store(T* p, V v) {
+    std::memcpy(p, &v, sizeof v);
+}
+// `at(p, i)` reads p[i]: one float, or sixteen from there (the fused row update below).
+template <unsigned Mask, bool Ext, class At>
+[[gnu::always_inline]] inline auto row_force(At at, const float* __restrict f0, const float* __restrict f1,
+                                             const float* __restrict f2, const float* __restrict ext, std::size_t D,
+                                             std::ptrdiff_t c) {
+    decltype(at(f0, c)) f{};
     if constexpr (kind_runs(Mask, SpringKind::Structural)) {
-        f = (f - f0[c - 1]) + f0[c];                  // (0,+1)
-        f = (f - f1[D + c]) + f0[D + c];              // (+1,0)
+        f = (f - at(f0, c - 1)) + at(f0, c);                  // (0,+1)
+        f = (f - at(f1, D + c)) + at(f0, D + c);              // (+1,0)
     }
     if constexpr (kind_runs(Mask, SpringKind::Shear)) {
-        f = (f - f1[2 * D + c - 1]) + f0[2 * D + c];  // (+1,+1)
-        f = (f - f1[3 * D + c + 1]) + f0[3 * D + c];  // (+1,-1)
+        f = (f - at(f1, 2 * D + c - 1)) + at(f0, 2 * D + c);  // (+1,+1)
+        f = (f - at(f1, 3 * D + c + 1)) + at(f0, 3 * D + c);  // (+1,-1)
     }
     if constexpr (kind_runs(Mask, SpringKind::Bending) && (Mask & kBendsBit)) {
         // Bends in the textbook's order, the one starting two before the particle first: -e, +2 e, -e.
-        f = ((f - f0[4 * D + c - 2]) + 2.0f * f0[4 * D + c - 1]) - f0[4 * D + c];  // along (0,+1)
-        f = ((f - f2[5 * D + c]) + 2.0f * f1[5 * D + c]) - f0[5 * D + c];          // along (+1,0)
+        f = ((f - at(f0, 4 * D + c - 2)) + 2.0f * at(f0, 4 * D + c - 1)) - at(f0, 4 * D + c);  // along (0,+1)
+        f = ((f - at(f2, 5 * D + c)) + 2.0f * at(f1, 5 * D + c)) - at(f0, 5 * D + c);          // along (+1,0)
     } else if constexpr (kind_runs(Mask, SpringKind::Bending)) {
-        f = (f - f0[4 * D + c - 2]) + f0[4 * D + c];  // (0,+2)
-        f = (f - f2[5 * D + c]) + f0[5 * D + c];      // (+2,0)
+        f = (f - at(f0, 4 * D + c - 2)) + at(f0, 4 * D + c);  // (0,+2)
+        f = (f - at(f2, 5 * D + c)) + at(f0, 5 * D + c);      // (+2,0)
     }
-    if constexpr (Ext) f += ext[c];
+    if constexpr (Ext) f += at(ext, c);
     return f;
 }
 
@@ -583,11 +557,16 @@ struct RowData {
 // inside), one component at a time. The force and the substep's change (f w + g) h2 are float,
 // the motion and the position double, as in integrate_verlet. A pinned particle (inverse mass 0) has no
 // change and zero motion, so it does not move. Every particle is read and written once.
-template <unsigned Mask, bool Ext>
+//
+// With `lanes` (the block's running bounds of the motion, reset_lanes' layout) the row's new motions widen
+// them while they are still in registers, sixteen columns at a time: column c goes to lane c mod 8, as
+// widen_tail takes it, and the bounds are exact (a minimum and a maximum round nothing).
+template <FastKernel K, unsigned Mask, bool Ext>
 [[gnu::always_inline]] inline void integrate_row(const RowData& row, int cols, std::size_t stride, double keep,
-                                                 float h2) {
+                                                 float h2, double* lanes) {
     const std::size_t D = 3 * stride;  // component rows of one spring row are 6 directions apart by 3 * stride
     const float* __restrict w = row.w;
+    const auto one = [](const float* p, std::ptrdiff_t i) { return p[i]; };
     for (int comp = 0; comp < 3; ++comp) {
         const float* __restrict f0 = row.f[comp][0];
         const float* __restrict f1 = row.f[comp][1];
@@ -596,30 +575,63 @@ template <unsigned Mask, bool Ext>
         double* __restrict x = row.x[comp];
         double* __restrict m = row.m[comp];
         const float g = row.g[comp];
-        for (int c = 0; c < cols; ++c) {
-            const float f = row_force<Mask, Ext>(f0, f1, f2, ext, D, c);
-            const float change = w[c] == 0.0f ? 0.0f : (f * w[c] + g) * h2;  // a select: the loop vectorises
-            const double step = m[c] * keep + static_cast<double>(change);
-            m[c] = step;
-            x[c] += step;
+        double* lo = lanes ? lanes + 8 * comp : nullptr;
+        double* hi = lanes ? lanes + 24 + 8 * comp : nullptr;
+        int c = 0;
+        if constexpr (K != FastKernel::Generic) {
+            if (lanes) {
+                // Column c widens lane c mod 8. Each instruction set takes vectors it has: with AVX-512 sixteen
+                // floats and two eight-double halves (lanes 0-7 twice: two running bounds, joined at the end),
+                // with AVX2 eight floats and two four-double halves (lanes 0-3 and 4-7). The floats are converted
+                // in one vector twice their width, which GCC 12 lowers to whole conversions.
+                const auto update = [&](auto change, int at, auto& low, auto& high) __attribute__((always_inline)) {
+                    using V = decltype(change);
+                    const V step = load<V>(m + at) * keep + change;
+                    store(m + at, step);
+                    store(x + at, load<V>(x + at) + step);
+                    low = low < step ? low : step;
+                    high = high > step ? high : step;
+                };
+                if constexpr (K == FastKernel::Avx512) {
+                    const auto sixteen = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                        return load<Floats16>(p + i);
+                    };
+                    Doubles8 lo0 = load<Doubles8>(lo), hi0 = load<Doubles8>(hi), lo1 = lo0, hi1 = hi0;
+                    for (; c + 16 <= cols; c += 16) {
+                        const Floats16 f = row_force<Mask, Ext>(sixteen, f0, f1, f2, ext, D, c);
+                        const Floats16 wc = load<Floats16>(w + c);
+                        const Floats16 change = wc == 0.0f ? Floats16{} : (f * wc + g) * h2;
+                        const Doubles16 wide = __builtin_convertvector(change, Doubles16);
+                        update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3, 4, 5, 6, 7), c, lo0, hi0);
+                        update(__builtin_shufflevector(wide, wide, 8, 9, 10, 11, 12, 13, 14, 15), c + 8, lo1, hi1);
+                    }
+                    store(lo, lo0 < lo1 ? lo0 : lo1), store(hi, hi0 > hi1 ? hi0 : hi1);
+                } else {
+                    const auto eight = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                        return load<Floats8>(p + i);
+                    };
+                    Doubles4 lo0 = load<Doubles4>(lo), lo1 = load<Doubles4>(lo + 4);
+                    Doubles4 hi0 = load<Doubles4>(hi), hi1 = load<Doubles4>(hi + 4);
+                    for (; c + 8 <= cols; c += 8) {
+                        const Floats8 f = row_force<Mask, Ext>(eight, f0, f1, f2, ext, D, c);
+                        const Floats8 wc = load<Floats8>(w + c);
+                        const Floats8 change = wc == 0.0f ? Floats8{} : (f * wc + g) * h2;
+                        const Doubles8 wide = __builtin_convertvector(change, Doubles8);
+                        update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3), c, lo0, hi0);
+                        update(__builtin_shufflevector(wide, wide, 4, 5, 6, 7), c + 4, lo1, hi1);
+                    }
+                    store(lo, lo0), store(lo + 4, lo1), store(hi, hi0), store(hi + 4, hi1);
+                }
+            }
         }
-    }
-}
-
-// Row i0's motion (cols particles) into the lanes, while the row the update just wrote is in L1.
-template <FastKernel K>
-[[gnu::always_inline]] inline void widen_row(const DVec3Array& motion, std::size_t i0, int cols, double* lanes) {
-    const double* comp[3] = {motion.x.data() + i0, motion.y.data() + i0, motion.z.data() + i0};
-    for (int k = 0; k < 3; ++k) {
-        double* lo = lanes + 8 * k;
-        double* hi = lanes + 24 + 8 * k;
-        if constexpr (K == FastKernel::Avx512) {
-            widen_avx512(comp[k], cols, lo, hi);
-        } else if constexpr (K == FastKernel::Avx2) {
-            widen_avx2(comp[k], cols, lo, hi);
-        } else {
-            widen_tail(comp[k], 0, cols, lo, hi);
+        for (int t = c; t < cols; ++t) {
+            const float f = row_force<Mask, Ext>(one, f0, f1, f2, ext, D, t);
+            const float change = w[t] == 0.0f ? 0.0f : (f * w[t] + g) * h2;  // a select: the loop vectorises
+            const double step = m[t] * keep + static_cast<double>(change);
+            m[t] = step;
+            x[t] += step;
         }
+        if (lanes) widen_tail(m, c, cols, lo, hi);
     }
 }
 
@@ -674,16 +686,14 @@ template <FastKernel K, unsigned Mask>
         row.g[0] = g.x, row.g[1] = g.y, row.g[2] = g.z;
         if (in.external) {
             row.ext[0] = in.external->x.data() + i0, row.ext[1] = in.external->y.data() + i0, row.ext[2] = in.external->z.data() + i0;
-            integrate_row<Mask, true>(row, grid.cols, stride, keep, h2);
+            integrate_row<K, Mask, true>(row, grid.cols, stride, keep, h2, in.motion_lanes);
         } else {
-            integrate_row<Mask, false>(row, grid.cols, stride, keep, h2);
+            integrate_row<K, Mask, false>(row, grid.cols, stride, keep, h2, in.motion_lanes);
         }
         // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
         if (in.row_boxes) {
             row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
         }
-        // Likewise its motion's bounds, for self-collision.
-        if (in.motion_lanes) widen_row<K>(state.motion, i0, grid.cols, in.motion_lanes);
     }
 }
 

@@ -494,12 +494,11 @@ template <FastKernel K, unsigned Mask>
     }
 }
 
-// Sixteen floats and eight doubles in GCC's vector extensions: each instruction set's sweep compiles them to
-// its own vectors (one 512-bit register, two 256-bit or four 128-bit ones), element-wise IEEE operations
-// without contraction (-ffp-contract=off), so a lane computes what the scalar loop computes.
-// Every function that takes or returns them is inlined into one sweep, so no call passes them across the
-// ABI that -Wpsabi warns about (the generic sweep's 512-bit vectors without AVX-512).
-#pragma GCC diagnostic ignored "-Wpsabi"
+// Vectors of floats and doubles in GCC's vector extensions, for the AVX-512 and AVX2 sweeps' row update:
+// element-wise IEEE operations without contraction (-ffp-contract=off), so a lane computes what the scalar
+// loop computes. Every function that takes or returns them is inlined into one sweep; -Wpsabi warns about
+// the ABI of the templates themselves, compiled for the baseline ISA, which no call ever uses.
+#pragma GCC diagnostic ignored "-Wpsabi"  // to the end of the file: GCC reports it there
 using Floats16 = float __attribute__((vector_size(64)));
 using Floats8 = float __attribute__((vector_size(32)));
 using Doubles4 = double __attribute__((vector_size(32)));
@@ -515,7 +514,7 @@ template <class V, class T>
 [[gnu::always_inline]] inline void store(T* p, V v) {
     std::memcpy(p, &v, sizeof v);
 }
-// `at(p, i)` reads p[i]: one float, or sixteen from there (the fused row update below).
+// `at(p, i)` reads p[i]: one float, or a vector of them from there (the row update's vector loops below).
 template <unsigned Mask, bool Ext, class At>
 [[gnu::always_inline]] inline auto row_force(At at, const float* __restrict f0, const float* __restrict f1,
                                              const float* __restrict f2, const float* __restrict ext, std::size_t D,
@@ -559,14 +558,15 @@ struct RowData {
 // change and zero motion, so it does not move. Every particle is read and written once.
 //
 // With `lanes` (the block's running bounds of the motion, reset_lanes' layout) the row's new motions widen
-// them while they are still in registers, sixteen columns at a time: column c goes to lane c mod 8, as
-// widen_tail takes it, and the bounds are exact (a minimum and a maximum round nothing).
+// them while they are still in registers, in whole vectors with AVX-512 and AVX2: column c goes to lane
+// c mod 8, as widen_tail takes it, and the bounds are exact (a minimum and a maximum round nothing). The
+// generic kernel, and the columns after the last whole vector, widen them in a second pass (widen_tail).
 template <FastKernel K, unsigned Mask, bool Ext>
 [[gnu::always_inline]] inline void integrate_row(const RowData& row, int cols, std::size_t stride, double keep,
                                                  float h2, double* lanes) {
     const std::size_t D = 3 * stride;  // component rows of one spring row are 6 directions apart by 3 * stride
     const float* __restrict w = row.w;
-    const auto one = [](const float* p, std::ptrdiff_t i) { return p[i]; };
+    const auto one = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) { return p[i]; };
     for (int comp = 0; comp < 3; ++comp) {
         const float* __restrict f0 = row.f[comp][0];
         const float* __restrict f1 = row.f[comp][1];
@@ -584,11 +584,11 @@ template <FastKernel K, unsigned Mask, bool Ext>
                 // floats and two eight-double halves (lanes 0-7 twice: two running bounds, joined at the end),
                 // with AVX2 eight floats and two four-double halves (lanes 0-3 and 4-7). The floats are converted
                 // in one vector twice their width, which GCC 12 lowers to whole conversions.
-                const auto update = [&](auto change, int at, auto& low, auto& high) __attribute__((always_inline)) {
+                const auto update = [&](auto change, int col, auto& low, auto& high) __attribute__((always_inline)) {
                     using V = decltype(change);
-                    const V step = load<V>(m + at) * keep + change;
-                    store(m + at, step);
-                    store(x + at, load<V>(x + at) + step);
+                    const V step = load<V>(m + col) * keep + change;
+                    store(m + col, step);
+                    store(x + col, load<V>(x + col) + step);
                     low = low < step ? low : step;
                     high = high > step ? high : step;
                 };

@@ -48,7 +48,7 @@ public:
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
     // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
     // block_starts(rows x cols) after the update, and `motion_bounds` (when not null) the bounds of every
-    // particle's new motion, each row's taken while it is in L1 (for self-collision, self_collision.hpp).
+    // particle's new motion, each row's taken in its update (for self-collision, self_collision.hpp).
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
               double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr);
 

@@ -325,12 +325,14 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
     for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
         if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
         const FastKernel was = FastSolver::use_kernel(kernel);
-        // drape-sphere in its per-spring form: a sagging, swinging cloth whose motions differ per particle. Its
-        // 40 columns take the row update's vector loop and its tail with each vector width (16 and 8 columns);
-        // 13 columns the tail alone with AVX-512, one vector and the tail with AVX2.
-        for (const int cols : {0, 13}) {
-            Scene scene = per_spring_scene("drape-sphere");
-            if (cols > 0) scene.cloth.rows = scene.cloth.cols = cols;
+        // drape-sphere in its per-spring form (a sagging, swinging cloth whose motions differ per particle, no
+        // pins) and hanging in its material form (pinned corners, bends). 40 columns take the row update's
+        // vector loop and its tail with AVX-512 (16 columns a vector), the vector loop alone with AVX2 (8);
+        // 21 columns both loops with both; 13 the tail alone with AVX-512.
+        for (const auto& [name, cols] : {std::pair{"drape-sphere", 40}, std::pair{"drape-sphere", 13},
+                                         std::pair{"hanging", 21}, std::pair{"hanging", 40}}) {
+            Scene scene = std::string(name) == "hanging" ? load_scene(name) : per_spring_scene(name);
+            scene.cloth.rows = scene.cloth.cols = cols;
             MassSpring sim = build_simulation(scene);
             sim.run_steps(20);
             for (int threads : {1, 3}) {
@@ -348,7 +350,8 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
                     solver->step(plain, scene.settings, 7u, ext, sim.substep_length(), nullptr, nullptr);
                     MotionBounds b;
                     solver->step(state, scene.settings, 7u, ext, sim.substep_length(), nullptr, &b);
-                    INFO(FastSolver::kernel_name() << ", " << threads << " thread(s), substep " << substep);
+                    INFO(name << " " << cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
+                              << " thread(s), substep " << substep);
                     CHECK(state.position == plain.position);
                     CHECK(state.motion == plain.motion);
                     REQUIRE_FALSE(b.empty);

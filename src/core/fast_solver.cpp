@@ -494,13 +494,15 @@ template <FastKernel K, unsigned Mask>
     }
 }
 
-// Vectors of floats and doubles in GCC's vector extensions, for the AVX-512 and AVX2 sweeps' row update:
+// Vectors of floats and doubles in GCC's vector extensions, for the row update of each sweep:
 // element-wise IEEE operations without contraction (-ffp-contract=off), so a lane computes what the scalar
 // loop computes. Every function that takes or returns them is inlined into one sweep; -Wpsabi warns about
 // the ABI of the templates themselves, compiled for the baseline ISA, which no call ever uses.
 #pragma GCC diagnostic ignored "-Wpsabi"  // to the end of the file: GCC reports it there
 using Floats16 = float __attribute__((vector_size(64)));
+using Floats4 = float __attribute__((vector_size(16)));
 using Floats8 = float __attribute__((vector_size(32)));
+using Doubles2 = double __attribute__((vector_size(16)));
 using Doubles4 = double __attribute__((vector_size(32)));
 using Doubles8 = double __attribute__((vector_size(64)));
 using Doubles16 = double __attribute__((vector_size(128)));
@@ -558,9 +560,9 @@ struct RowData {
 // change and zero motion, so it does not move. Every particle is read and written once.
 //
 // With `lanes` (the block's running bounds of the motion, reset_lanes' layout) the row's new motions widen
-// them while they are still in registers, in whole vectors with AVX-512 and AVX2: column c goes to lane
-// c mod 8, as widen_tail takes it, and the bounds are exact (a minimum and a maximum round nothing). The
-// generic kernel, and the columns after the last whole vector, widen them in a second pass (widen_tail).
+// them while they are still in registers, in whole vectors: column c goes to lane c mod 8, as widen_tail
+// takes it, and the bounds are exact (a minimum and a maximum round nothing). The columns after the last
+// whole vector widen them in a second pass (widen_tail).
 template <FastKernel K, unsigned Mask, bool Ext>
 [[gnu::always_inline]] inline void integrate_row(const RowData& row, int cols, std::size_t stride, double keep,
                                                  float h2, double* lanes) {
@@ -578,50 +580,67 @@ template <FastKernel K, unsigned Mask, bool Ext>
         double* lo = lanes ? lanes + 8 * comp : nullptr;
         double* hi = lanes ? lanes + 24 + 8 * comp : nullptr;
         int c = 0;
-        if constexpr (K != FastKernel::Generic) {
-            if (lanes) {
-                // Column c widens lane c mod 8. Each instruction set takes vectors it has: with AVX-512 sixteen
-                // floats and two eight-double halves (lanes 0-7 twice: two running bounds, joined at the end),
-                // with AVX2 eight floats and two four-double halves (lanes 0-3 and 4-7). The floats are converted
-                // in one vector twice their width, which GCC 12 lowers to whole conversions.
-                const auto update = [&](auto change, int col, auto& low, auto& high) __attribute__((always_inline)) {
-                    using V = decltype(change);
-                    const V step = load<V>(m + col) * keep + change;
-                    store(m + col, step);
-                    store(x + col, load<V>(x + col) + step);
-                    low = low < step ? low : step;
-                    high = high > step ? high : step;
+        if (lanes) {
+            // Column c widens lane c mod 8. Each instruction set takes vectors it has: with AVX-512 sixteen
+            // floats and two eight-double halves (lanes 0-7 twice: two running bounds, joined at the end),
+            // with AVX2 eight floats and two four-double halves (lanes 0-3 and 4-7), with the baseline's
+            // SSE2 four floats and two two-double halves, twice (lanes 0-1, 2-3, 4-5 and 6-7). The floats are
+            // converted in one vector twice their width, which GCC 12 lowers to whole conversions.
+            const auto update = [&](auto change, int col, auto& low, auto& high) __attribute__((always_inline)) {
+                using V = decltype(change);
+                const V step = load<V>(m + col) * keep + change;
+                store(m + col, step);
+                store(x + col, load<V>(x + col) + step);
+                low = low < step ? low : step;
+                high = high > step ? high : step;
+            };
+            if constexpr (K == FastKernel::Avx512) {
+                const auto sixteen = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                    return load<Floats16>(p + i);
                 };
-                if constexpr (K == FastKernel::Avx512) {
-                    const auto sixteen = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
-                        return load<Floats16>(p + i);
-                    };
-                    Doubles8 lo0 = load<Doubles8>(lo), hi0 = load<Doubles8>(hi), lo1 = lo0, hi1 = hi0;
-                    for (; c + 16 <= cols; c += 16) {
-                        const Floats16 f = row_force<Mask, Ext>(sixteen, f0, f1, f2, ext, D, c);
-                        const Floats16 wc = load<Floats16>(w + c);
-                        const Floats16 change = wc == 0.0f ? Floats16{} : (f * wc + g) * h2;
-                        const Doubles16 wide = __builtin_convertvector(change, Doubles16);
-                        update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3, 4, 5, 6, 7), c, lo0, hi0);
-                        update(__builtin_shufflevector(wide, wide, 8, 9, 10, 11, 12, 13, 14, 15), c + 8, lo1, hi1);
-                    }
-                    store(lo, lo0 < lo1 ? lo0 : lo1), store(hi, hi0 > hi1 ? hi0 : hi1);
-                } else {
-                    const auto eight = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
-                        return load<Floats8>(p + i);
-                    };
-                    Doubles4 lo0 = load<Doubles4>(lo), lo1 = load<Doubles4>(lo + 4);
-                    Doubles4 hi0 = load<Doubles4>(hi), hi1 = load<Doubles4>(hi + 4);
-                    for (; c + 8 <= cols; c += 8) {
-                        const Floats8 f = row_force<Mask, Ext>(eight, f0, f1, f2, ext, D, c);
-                        const Floats8 wc = load<Floats8>(w + c);
-                        const Floats8 change = wc == 0.0f ? Floats8{} : (f * wc + g) * h2;
-                        const Doubles8 wide = __builtin_convertvector(change, Doubles8);
-                        update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3), c, lo0, hi0);
-                        update(__builtin_shufflevector(wide, wide, 4, 5, 6, 7), c + 4, lo1, hi1);
-                    }
-                    store(lo, lo0), store(lo + 4, lo1), store(hi, hi0), store(hi + 4, hi1);
+                Doubles8 lo0 = load<Doubles8>(lo), hi0 = load<Doubles8>(hi), lo1 = lo0, hi1 = hi0;
+                for (; c + 16 <= cols; c += 16) {
+                    const Floats16 f = row_force<Mask, Ext>(sixteen, f0, f1, f2, ext, D, c);
+                    const Floats16 wc = load<Floats16>(w + c);
+                    const Floats16 change = wc == 0.0f ? Floats16{} : (f * wc + g) * h2;
+                    const Doubles16 wide = __builtin_convertvector(change, Doubles16);
+                    update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3, 4, 5, 6, 7), c, lo0, hi0);
+                    update(__builtin_shufflevector(wide, wide, 8, 9, 10, 11, 12, 13, 14, 15), c + 8, lo1, hi1);
                 }
+                store(lo, lo0 < lo1 ? lo0 : lo1), store(hi, hi0 > hi1 ? hi0 : hi1);
+            } else if constexpr (K == FastKernel::Avx2) {
+                const auto eight = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                    return load<Floats8>(p + i);
+                };
+                Doubles4 lo0 = load<Doubles4>(lo), lo1 = load<Doubles4>(lo + 4);
+                Doubles4 hi0 = load<Doubles4>(hi), hi1 = load<Doubles4>(hi + 4);
+                for (; c + 8 <= cols; c += 8) {
+                    const Floats8 f = row_force<Mask, Ext>(eight, f0, f1, f2, ext, D, c);
+                    const Floats8 wc = load<Floats8>(w + c);
+                    const Floats8 change = wc == 0.0f ? Floats8{} : (f * wc + g) * h2;
+                    const Doubles8 wide = __builtin_convertvector(change, Doubles8);
+                    update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3), c, lo0, hi0);
+                    update(__builtin_shufflevector(wide, wide, 4, 5, 6, 7), c + 4, lo1, hi1);
+                }
+                store(lo, lo0), store(lo + 4, lo1), store(hi, hi0), store(hi + 4, hi1);
+            } else {
+                const auto four = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                    return load<Floats4>(p + i);
+                };
+                Doubles2 low[4], high[4];
+                for (int j = 0; j < 4; ++j) low[j] = load<Doubles2>(lo + 2 * j), high[j] = load<Doubles2>(hi + 2 * j);
+                for (; c + 8 <= cols; c += 8) {
+                    for (int half = 0; half < 2; ++half) {
+                        const int col = c + 4 * half;
+                        const Floats4 f = row_force<Mask, Ext>(four, f0, f1, f2, ext, D, col);
+                        const Floats4 wc = load<Floats4>(w + col);
+                        const Floats4 change = wc == 0.0f ? Floats4{} : (f * wc + g) * h2;
+                        const Doubles4 wide = __builtin_convertvector(change, Doubles4);
+                        update(__builtin_shufflevector(wide, wide, 0, 1), col, low[2 * half], high[2 * half]);
+                        update(__builtin_shufflevector(wide, wide, 2, 3), col + 2, low[2 * half + 1], high[2 * half + 1]);
+                    }
+                }
+                for (int j = 0; j < 4; ++j) store(lo + 2 * j, low[j]), store(hi + 2 * j, high[j]);
             }
         }
         for (int t = c; t < cols; ++t) {

@@ -637,7 +637,8 @@ template <FastKernel K, unsigned Mask, bool Ext>
                         const Floats4 change = wc == 0.0f ? Floats4{} : (f * wc + g) * h2;
                         const Doubles4 wide = __builtin_convertvector(change, Doubles4);
                         update(__builtin_shufflevector(wide, wide, 0, 1), col, low[2 * half], high[2 * half]);
-                        update(__builtin_shufflevector(wide, wide, 2, 3), col + 2, low[2 * half + 1], high[2 * half + 1]);
+                        update(__builtin_shufflevector(wide, wide, 2, 3), col + 2, low[2 * half + 1],
+                               high[2 * half + 1]);
                     }
                 }
                 for (int j = 0; j < 4; ++j) store(lo + 2 * j, low[j]), store(hi + 2 * j, high[j]);

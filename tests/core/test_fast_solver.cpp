@@ -327,8 +327,8 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
         const FastKernel was = FastSolver::use_kernel(kernel);
         // drape-sphere in its per-spring form (a sagging, swinging cloth whose motions differ per particle, no
         // pins) and hanging in its material form (pinned corners, bends). 40 columns take the row update's
-        // vector loop and its tail with AVX-512 (16 columns a vector), the vector loop alone with AVX2 (8);
-        // 21 columns both loops with both; 13 the tail alone with AVX-512.
+        // vector loop and its tail with AVX-512 (16 columns a vector), the vector loop alone with AVX2 and the
+        // generic kernel (8); 21 columns both loops with all three; 13 the tail alone with AVX-512.
         for (const auto& [name, cols] : {std::pair{"drape-sphere", 40}, std::pair{"drape-sphere", 13},
                                          std::pair{"hanging", 21}, std::pair{"hanging", 40}}) {
             Scene scene = std::string(name) == "hanging" ? load_scene(name) : per_spring_scene(name);

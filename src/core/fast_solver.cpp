@@ -594,48 +594,43 @@ template <FastKernel K, unsigned Mask, bool Ext>
                 low = low < step ? low : step;
                 high = high > step ? high : step;
             };
-            if constexpr (K == FastKernel::Avx512) {
-                const auto sixteen = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
-                    return load<Floats16>(p + i);
+            // The substep's changes (f w + g) h2 (0 where pinned) of the columns from `col` in a float vector
+            // like `narrow`, widened to double in one vector like `wide`, twice its width.
+            const auto widened_change = [&](auto narrow, auto wide, int col) __attribute__((always_inline)) {
+                using F = decltype(narrow);
+                using W = decltype(wide);
+                const auto read = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
+                    return load<F>(p + i);
                 };
+                const F f = row_force<Mask, Ext>(read, f0, f1, f2, ext, D, col);
+                const F wc = load<F>(w + col);
+                const F change = wc == 0.0f ? F{} : (f * wc + g) * h2;
+                return __builtin_convertvector(change, W);
+            };
+            if constexpr (K == FastKernel::Avx512) {
                 Doubles8 lo0 = load<Doubles8>(lo), hi0 = load<Doubles8>(hi), lo1 = lo0, hi1 = hi0;
                 for (; c + 16 <= cols; c += 16) {
-                    const Floats16 f = row_force<Mask, Ext>(sixteen, f0, f1, f2, ext, D, c);
-                    const Floats16 wc = load<Floats16>(w + c);
-                    const Floats16 change = wc == 0.0f ? Floats16{} : (f * wc + g) * h2;
-                    const Doubles16 wide = __builtin_convertvector(change, Doubles16);
+                    const Doubles16 wide = widened_change(Floats16{}, Doubles16{}, c);
                     update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3, 4, 5, 6, 7), c, lo0, hi0);
                     update(__builtin_shufflevector(wide, wide, 8, 9, 10, 11, 12, 13, 14, 15), c + 8, lo1, hi1);
                 }
                 store(lo, lo0 < lo1 ? lo0 : lo1), store(hi, hi0 > hi1 ? hi0 : hi1);
             } else if constexpr (K == FastKernel::Avx2) {
-                const auto eight = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
-                    return load<Floats8>(p + i);
-                };
                 Doubles4 lo0 = load<Doubles4>(lo), lo1 = load<Doubles4>(lo + 4);
                 Doubles4 hi0 = load<Doubles4>(hi), hi1 = load<Doubles4>(hi + 4);
                 for (; c + 8 <= cols; c += 8) {
-                    const Floats8 f = row_force<Mask, Ext>(eight, f0, f1, f2, ext, D, c);
-                    const Floats8 wc = load<Floats8>(w + c);
-                    const Floats8 change = wc == 0.0f ? Floats8{} : (f * wc + g) * h2;
-                    const Doubles8 wide = __builtin_convertvector(change, Doubles8);
+                    const Doubles8 wide = widened_change(Floats8{}, Doubles8{}, c);
                     update(__builtin_shufflevector(wide, wide, 0, 1, 2, 3), c, lo0, hi0);
                     update(__builtin_shufflevector(wide, wide, 4, 5, 6, 7), c + 4, lo1, hi1);
                 }
                 store(lo, lo0), store(lo + 4, lo1), store(hi, hi0), store(hi + 4, hi1);
             } else {
-                const auto four = [](const float* p, std::ptrdiff_t i) __attribute__((always_inline)) {
-                    return load<Floats4>(p + i);
-                };
                 Doubles2 low[4], high[4];
                 for (int j = 0; j < 4; ++j) low[j] = load<Doubles2>(lo + 2 * j), high[j] = load<Doubles2>(hi + 2 * j);
                 for (; c + 8 <= cols; c += 8) {
                     for (int half = 0; half < 2; ++half) {
                         const int col = c + 4 * half;
-                        const Floats4 f = row_force<Mask, Ext>(four, f0, f1, f2, ext, D, col);
-                        const Floats4 wc = load<Floats4>(w + col);
-                        const Floats4 change = wc == 0.0f ? Floats4{} : (f * wc + g) * h2;
-                        const Doubles4 wide = __builtin_convertvector(change, Doubles4);
+                        const Doubles4 wide = widened_change(Floats4{}, Doubles4{}, col);
                         update(__builtin_shufflevector(wide, wide, 0, 1), col, low[2 * half], high[2 * half]);
                         update(__builtin_shufflevector(wide, wide, 2, 3), col + 2, low[2 * half + 1],
                                high[2 * half + 1]);

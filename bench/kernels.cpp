@@ -1,6 +1,8 @@
 // Google Benchmark microbenchmarks of the step's kernels, on the hanging scene at several grid sizes:
 // the textbook spring loop, one fast-solver substep (springs + integration + collisions fused), the
-// textbook Verlet update, collisions with a sphere the cloth lies on, and the renderer's vertex normals.
+// textbook Verlet update, collisions with a sphere the cloth lies on, and the renderer's vertex normals. And
+// what the fast solver's threads cost per substep with no work at all: the parallel region it opens each
+// substep against the barriers one region per step would need instead (docs/PERFORMANCE.md, session 17).
 #include "clothsim/colliders.hpp"
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
@@ -11,6 +13,7 @@
 #include "per_spring_scenes.hpp"
 
 #include <benchmark/benchmark.h>
+#include <omp.h>
 
 namespace {
 
@@ -103,11 +106,42 @@ void BM_VertexNormals(benchmark::State& state) {
 
 }  // namespace
 
+// The synchronisation of one substep of FastSolver::step on `range(0)` threads, with no work: a parallel
+// region with the barrier after the boundary spring rows inside ...
+void BM_RegionPerSubstep(benchmark::State& state) {
+    const int threads = static_cast<int>(state.range(0));
+    int sink = 0;
+    for (auto _ : state) {
+#pragma omp parallel num_threads(threads)
+        {
+            benchmark::DoNotOptimize(sink);
+#pragma omp barrier
+        }
+    }
+}
+// ... against what one region per step would still need each substep: that barrier, and one at the end of
+// the substep before the next reads the positions another thread wrote (timed per substep).
+void BM_BarriersPerSubstep(benchmark::State& state) {
+    const int threads = static_cast<int>(state.range(0));
+    constexpr int kSubsteps = 1000;
+    for (auto _ : state) {
+#pragma omp parallel num_threads(threads)
+        for (int i = 0; i < kSubsteps; ++i) {
+#pragma omp barrier
+#pragma omp barrier
+        }
+    }
+    state.SetItemsProcessed(state.iterations() * kSubsteps);
+}
+
 BENCHMARK(BM_TextbookSpringForces)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_TextbookSubstep)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_FastSubstep)->Args({64, 1})->Args({128, 1})->Args({256, 1})->Args({128, 2})->Args({256, 2})->UseRealTime();
 BENCHMARK(BM_IntegrateVerlet)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_CollideSphere)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_VertexNormals)->Args({128, 0})->Args({128, 1})->Args({256, 0})->Args({256, 1})->UseRealTime();
+
+BENCHMARK(BM_RegionPerSubstep)->Arg(2)->UseRealTime();
+BENCHMARK(BM_BarriersPerSubstep)->Arg(2)->UseRealTime();
 
 BENCHMARK_MAIN();

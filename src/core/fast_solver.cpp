@@ -64,34 +64,70 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
     }
 }
 
-// Eight springs from their differences: the float arithmetic both vector kernels share.
+// The first n of eight lanes (0 < n < 8) as AVX2's masked loads and stores take them: all bits set in a lane
+// that is in, none in one that is out.
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m256i first_lanes8(int n) {
+    return _mm256_cmpgt_epi32(_mm256_set1_epi32(n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+}
+
+// Eight springs from their differences: the float arithmetic both vector kernels share. With `tail` (a run's
+// last 1 to 7 springs, AVX2) the rest lengths are read and the forces written in its lanes only; the others
+// compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void forces8(__m256 dx, __m256 dy, __m256 dz,
                                                                                 const float* rest, float k,
-                                                                                float* fx, float* fy, float* fz) {
+                                                                                float* fx, float* fy, float* fz,
+                                                                                const __m256i* tail = nullptr) {
     const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
     const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                     _mm256_mul_ps(dz, dz));
     const __m256 length = _mm256_sqrt_ps(r2);
-    const __m256 l0 = _mm256_loadu_ps(rest);
+    const __m256 l0 = tail ? _mm256_maskload_ps(rest, *tail) : _mm256_loadu_ps(rest);
     const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, _mm256_sub_ps(length, l0)), length);
     const __m256 apart = _mm256_blendv_ps(zero, stretched, _mm256_cmp_ps(length, tiny, _CMP_GT_OQ));
     const __m256 s = _mm256_blendv_ps(apart, vk, _mm256_cmp_ps(l0, zero, _CMP_EQ_OQ));
-    _mm256_storeu_ps(fx, _mm256_mul_ps(s, dx));
-    _mm256_storeu_ps(fy, _mm256_mul_ps(s, dy));
-    _mm256_storeu_ps(fz, _mm256_mul_ps(s, dz));
+    if (tail) {
+        _mm256_maskstore_ps(fx, *tail, _mm256_mul_ps(s, dx));
+        _mm256_maskstore_ps(fy, *tail, _mm256_mul_ps(s, dy));
+        _mm256_maskstore_ps(fz, *tail, _mm256_mul_ps(s, dz));
+    } else {
+        _mm256_storeu_ps(fx, _mm256_mul_ps(s, dx));
+        _mm256_storeu_ps(fy, _mm256_mul_ps(s, dy));
+        _mm256_storeu_ps(fz, _mm256_mul_ps(s, dz));
+    }
 }
 
-// Eight differences p[i + offset] - p[i] in double, rounded to float: two 4-wide halves with AVX2, ...
-[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m256 difference8_avx2(const double* p, int i,
-                                                                                          int offset) {
-    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset), _mm256_loadu_pd(p + i)));
-    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(p + i + offset + 4), _mm256_loadu_pd(p + i + 4)));
+// Four doubles from p, or only the lanes of `mask` (first_lanes8's halves; the others read as zero).
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m256d load4(const double* p, const __m256i* mask) {
+    return mask ? _mm256_maskload_pd(p, *mask) : _mm256_loadu_pd(p);
+}
+// A first_lanes8 mask's halves as masks of four doubles (lanes 0-3 and 4-7).
+struct DoubleHalves {
+    __m256i half[2];
+};
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline DoubleHalves double_halves(__m256i lanes) {
+    return {{_mm256_cvtepi32_epi64(_mm256_castsi256_si128(lanes)),
+             _mm256_cvtepi32_epi64(_mm256_extracti128_si256(lanes, 1))}};
+}
+
+// Eight differences p[i + offset] - p[i] in double, rounded to float: two 4-wide halves with AVX2 (with
+// `halves`, double_halves' masks, only their lanes are read), ...
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m256 difference8_avx2(
+    const double* p, int i, int offset, const DoubleHalves* halves = nullptr) {
+    const __m256i* m0 = halves ? &halves->half[0] : nullptr;
+    const __m256i* m1 = halves ? &halves->half[1] : nullptr;
+    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(load4(p + i + offset, m0), load4(p + i, m0)));
+    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(load4(p + i + offset + 4, m1), load4(p + i + 4, m1)));
     return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
 }
-// ... one 8-wide subtraction and conversion with AVX-512.
+// ... one 8-wide subtraction and conversion with AVX-512; with `lanes` less than all eight, only those lanes'
+// positions are read (the others are zero).
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m256 difference8_avx512(
-    const double* p, int i, int offset) {
+    const double* p, int i, int offset, __mmask8 lanes = 0xFF) {
     // maskz with all lanes: _mm512_cvtpd_ps itself trips GCC 12's -Wmaybe-uninitialized in its header.
+    if (lanes != 0xFF) {
+        return _mm512_maskz_cvtpd_ps(
+            0xFF, _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p + i + offset), _mm512_maskz_loadu_pd(lanes, p + i)));
+    }
     return _mm512_maskz_cvtpd_ps(0xFF, _mm512_sub_pd(_mm512_loadu_pd(p + i + offset), _mm512_loadu_pd(p + i)));
 }
 
@@ -104,27 +140,48 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, con
         forces8(difference8_avx2(x, i, offset), difference8_avx2(y, i, offset), difference8_avx2(z, i, offset),
                 rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
     }
-    spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+    if (i < end) {  // the last 1 to 7 springs, in masked lanes
+        const __m256i lanes = first_lanes8(end - i);
+        const DoubleHalves halves = double_halves(lanes);
+        forces8(difference8_avx2(x, i, offset, &halves), difference8_avx2(y, i, offset, &halves),
+                difference8_avx2(z, i, offset, &halves), rest + i, k, fx + (i - begin), fy + (i - begin),
+                fz + (i - begin), &lanes);
+    }
 }
 // Sixteen springs from their differences: forces8's arithmetic, operation for operation, in 512-bit vectors
-// (the square root and the divide, which bound the kernel, then take half the instructions).
+// (the square root and the divide, which bound the kernel, then take half the instructions). With `lanes`
+// less than all sixteen (a run's last springs) the rest lengths are read and the forces written in those
+// lanes only; the others compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) inline void forces16(
-    __m512 dx, __m512 dy, __m512 dz, const float* rest, float k, float* fx, float* fy, float* fz) {
+    __m512 dx, __m512 dy, __m512 dz, const float* rest, float k, float* fx, float* fy, float* fz,
+    __mmask16 lanes = 0xFFFF) {
     const __m512 vk = _mm512_set1_ps(k), tiny = _mm512_set1_ps(1e-12f), zero = _mm512_setzero_ps();
     const __m512 r2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
                                     _mm512_mul_ps(dz, dz));
     const __m512 length = _mm512_maskz_sqrt_ps(0xFFFF, r2);  // maskz: the unmasked form trips -Wmaybe-uninitialized
-    const __m512 l0 = _mm512_loadu_ps(rest);
+    const __m512 l0 = lanes == 0xFFFF ? _mm512_loadu_ps(rest) : _mm512_maskz_loadu_ps(lanes, rest);
     const __m512 stretched = _mm512_div_ps(_mm512_mul_ps(vk, _mm512_sub_ps(length, l0)), length);
     const __m512 apart = _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(length, tiny, _CMP_GT_OQ), stretched);
     const __m512 s = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(l0, zero, _CMP_EQ_OQ), apart, vk);
-    _mm512_storeu_ps(fx, _mm512_mul_ps(s, dx));
-    _mm512_storeu_ps(fy, _mm512_mul_ps(s, dy));
-    _mm512_storeu_ps(fz, _mm512_mul_ps(s, dz));
+    if (lanes == 0xFFFF) {
+        _mm512_storeu_ps(fx, _mm512_mul_ps(s, dx));
+        _mm512_storeu_ps(fy, _mm512_mul_ps(s, dy));
+        _mm512_storeu_ps(fz, _mm512_mul_ps(s, dz));
+    } else {
+        _mm512_mask_storeu_ps(fx, lanes, _mm512_mul_ps(s, dx));
+        _mm512_mask_storeu_ps(fy, lanes, _mm512_mul_ps(s, dy));
+        _mm512_mask_storeu_ps(fz, lanes, _mm512_mul_ps(s, dz));
+    }
 }
-// Sixteen differences: two 8-wide subtractions and conversions, joined.
+// Sixteen differences: two 8-wide subtractions and conversions, joined. With `lanes` less than all sixteen,
+// only those lanes' positions are read (the others are zero).
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) inline __m512 difference16_avx512(
-    const double* p, int i, int offset) {
+    const double* p, int i, int offset, __mmask16 lanes = 0xFFFF) {
+    if (lanes != 0xFFFF) {
+        return _mm512_insertf32x8(
+            _mm512_castps256_ps512(difference8_avx512(p, i, offset, static_cast<__mmask8>(lanes))),
+            difference8_avx512(p, i + 8, offset, static_cast<__mmask8>(lanes >> 8)), 1);
+    }
     return _mm512_insertf32x8(_mm512_castps256_ps512(difference8_avx512(p, i, offset)),
                               difference8_avx512(p, i + 8, offset), 1);
 }
@@ -137,11 +194,12 @@ __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) void spring_forces
         forces16(difference16_avx512(x, i, offset), difference16_avx512(y, i, offset),
                  difference16_avx512(z, i, offset), rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
     }
-    for (; i + 8 <= end; i += 8) {
-        forces8(difference8_avx512(x, i, offset), difference8_avx512(y, i, offset), difference8_avx512(z, i, offset),
-                rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+    if (i < end) {  // the last 1 to 15 springs, in masked lanes
+        const auto lanes = static_cast<__mmask16>((1u << (end - i)) - 1u);
+        forces16(difference16_avx512(x, i, offset, lanes), difference16_avx512(y, i, offset, lanes),
+                 difference16_avx512(z, i, offset, lanes), rest + i, k, fx + (i - begin), fy + (i - begin),
+                 fz + (i - begin), lanes);
     }
-    spring_forces_generic(x, y, z, rest, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
 // Bend forces of one run of bends from i along `offset`: e = k float((x_i - x_m) + (x_b - x_m)), m = i + offset,
@@ -158,45 +216,65 @@ __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) void spring_forces
         fz[i - begin] = k * static_cast<float>((z[i] - z[m]) + (z[b] - z[m]));
     }
 }
-[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m128 second_difference4_avx2(const double* p, int i,
-                                                                                                  int offset) {
-    const __m256d m = _mm256_loadu_pd(p + i + offset);
-    return _mm256_cvtpd_ps(_mm256_add_pd(_mm256_sub_pd(_mm256_loadu_pd(p + i), m),
-                                         _mm256_sub_pd(_mm256_loadu_pd(p + i + 2 * offset), m)));
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline __m128 second_difference4_avx2(
+    const double* p, int i, int offset, const __m256i* mask) {
+    const __m256d m = load4(p + i + offset, mask);
+    return _mm256_cvtpd_ps(_mm256_add_pd(_mm256_sub_pd(load4(p + i, mask), m),
+                                         _mm256_sub_pd(load4(p + i + 2 * offset, mask), m)));
+}
+// Eight bends from i; with `tail` (first_lanes8's mask of a run's last 1 to 7), only its lanes are read and
+// written.
+[[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void bends8_avx2(const double* const p[3], int i,
+                                                                                   int offset, __m256 vk,
+                                                                                   float* const out[3],
+                                                                                   const __m256i* tail = nullptr) {
+    const DoubleHalves halves = tail ? double_halves(*tail) : DoubleHalves{};
+    const __m256i* m0 = tail ? &halves.half[0] : nullptr;
+    const __m256i* m1 = tail ? &halves.half[1] : nullptr;
+    for (int c = 0; c < 3; ++c) {
+        const __m256 d = _mm256_mul_ps(vk, _mm256_insertf128_ps(
+                                               _mm256_castps128_ps256(second_difference4_avx2(p[c], i, offset, m0)),
+                                               second_difference4_avx2(p[c], i + 4, offset, m1), 1));
+        if (tail) {
+            _mm256_maskstore_ps(out[c], *tail, d);
+        } else {
+            _mm256_storeu_ps(out[c], d);
+        }
+    }
 }
 __attribute__((target("avx2,fma"))) void bend_forces_avx2(const double* x, const double* y, const double* z,
                                                            int offset, int begin, int end, float k, float* fx,
                                                            float* fy, float* fz) {
     const __m256 vk = _mm256_set1_ps(k);
+    const double* const p[3] = {x, y, z};
     int i = begin;
     for (; i + 8 <= end; i += 8) {
-        float* out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
-        const double* p[3] = {x, y, z};
-        for (int c = 0; c < 3; ++c) {
-            const __m256 d = _mm256_insertf128_ps(_mm256_castps128_ps256(second_difference4_avx2(p[c], i, offset)),
-                                                  second_difference4_avx2(p[c], i + 4, offset), 1);
-            _mm256_storeu_ps(out[c], _mm256_mul_ps(vk, d));
-        }
+        float* const out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        bends8_avx2(p, i, offset, vk, out);
     }
-    bend_forces_generic(x, y, z, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+    if (i < end) {  // the last 1 to 7 bends, in masked lanes
+        const __m256i lanes = first_lanes8(end - i);
+        float* const out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        bends8_avx2(p, i, offset, vk, out, &lanes);
+    }
 }
 __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(const double* x, const double* y,
                                                                              const double* z, int offset, int begin,
                                                                              int end, float k, float* fx, float* fy,
                                                                              float* fz) {
     const __m256 vk = _mm256_set1_ps(k);
-    int i = begin;
-    for (; i + 8 <= end; i += 8) {
+    // Eight bends a vector; the last 1 to 7 in masked lanes (the others read nothing and are not written).
+    for (int i = begin; i < end; i += 8) {
+        const auto lanes = static_cast<__mmask8>(end - i >= 8 ? 0xFFu : (1u << (end - i)) - 1u);
         float* out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
         const double* p[3] = {x, y, z};
         for (int c = 0; c < 3; ++c) {
-            const __m512d m = _mm512_loadu_pd(p[c] + i + offset);
-            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_loadu_pd(p[c] + i), m),
-                                            _mm512_sub_pd(_mm512_loadu_pd(p[c] + i + 2 * offset), m));
-            _mm256_storeu_ps(out[c], _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
+            const __m512d m = _mm512_maskz_loadu_pd(lanes, p[c] + i + offset);
+            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i), m),
+                                            _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i + 2 * offset), m));
+            _mm256_mask_storeu_ps(out[c], lanes, _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
         }
     }
-    bend_forces_generic(x, y, z, offset, i, end, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
 }
 
 // The running bounds of a block's motion in eight lanes per component (lane j: columns j, j + 8, ...), so a

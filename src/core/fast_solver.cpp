@@ -70,8 +70,8 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
     return _mm256_cmpgt_epi32(_mm256_set1_epi32(n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
 }
 
-// Eight springs from their differences: the float arithmetic both vector kernels share. With `tail` (a run's
-// last 1 to 7 springs, AVX2) the rest lengths are read and the forces written in its lanes only; the others
+// Eight springs from their differences: the AVX2 kernel's float arithmetic (forces16 is the same in 512-bit
+// vectors). With `tail` (a run's last 1 to 7 springs) the rest lengths are read and the forces written in its lanes only; the others
 // compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void forces8(__m256 dx, __m256 dy, __m256 dz,
                                                                                 const float* rest, float k,
@@ -131,7 +131,7 @@ struct DoubleHalves {
     return _mm512_maskz_cvtpd_ps(0xFF, _mm512_sub_pd(_mm512_loadu_pd(p + i + offset), _mm512_loadu_pd(p + i)));
 }
 
-// The vector kernels: eight springs at a time; the tail reuses the generic loop.
+// The AVX2 kernel: eight springs at a time, the last 1 to 7 in masked lanes.
 __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, const double* y, const double* z,
                                                              const float* rest, int offset, int begin, int end,
                                                              float k, float* fx, float* fy, float* fz) {
@@ -263,16 +263,25 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(con
                                                                              int end, float k, float* fx, float* fy,
                                                                              float* fz) {
     const __m256 vk = _mm256_set1_ps(k);
-    // Eight bends a vector; the last 1 to 7 in masked lanes (the others read nothing and are not written).
-    for (int i = begin; i < end; i += 8) {
-        const auto lanes = static_cast<__mmask8>(end - i >= 8 ? 0xFFu : (1u << (end - i)) - 1u);
-        float* out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
-        const double* p[3] = {x, y, z};
+    const double* const p[3] = {x, y, z};
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        for (int c = 0; c < 3; ++c) {
+            const __m512d m = _mm512_loadu_pd(p[c] + i + offset);
+            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_loadu_pd(p[c] + i), m),
+                                            _mm512_sub_pd(_mm512_loadu_pd(p[c] + i + 2 * offset), m));
+            _mm256_storeu_ps((c == 0 ? fx : c == 1 ? fy : fz) + (i - begin),
+                             _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
+        }
+    }
+    if (i < end) {  // the last 1 to 7 bends, in masked lanes (the others read nothing and are not written)
+        const auto lanes = static_cast<__mmask8>((1u << (end - i)) - 1u);
         for (int c = 0; c < 3; ++c) {
             const __m512d m = _mm512_maskz_loadu_pd(lanes, p[c] + i + offset);
             const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i), m),
                                             _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i + 2 * offset), m));
-            _mm256_mask_storeu_ps(out[c], lanes, _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
+            _mm256_mask_storeu_ps((c == 0 ? fx : c == 1 ? fy : fz) + (i - begin), lanes,
+                                  _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
         }
     }
 }

@@ -367,3 +367,61 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
         FastSolver::use_kernel(was);
     }
 }
+
+TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of every block after the update, NaN "
+          "particles left out, for every kernel and thread count, and taking them changes no position",
+          "[fast_solver][broad_phase]") {
+    const FastKernel best = FastSolver::best_kernel();
+    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
+        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
+        const FastKernel was = FastSolver::use_kernel(kernel);
+        // 48 columns: three whole blocks of kBlockParticles (16); 40: two and a partial one; 13: a partial block
+        // alone. Substeps alternate the row update with and without the motion's bounds (its two loops).
+        for (int cols : {48, 40, 13}) {
+            Scene scene = per_spring_scene("drape-sphere");
+            scene.cloth.rows = scene.cloth.cols = cols;
+            MassSpring sim = build_simulation(scene);
+            sim.run_steps(20);
+            for (int threads : {1, 3}) {
+                scene.settings.solver.threads = threads;
+                std::optional<FastSolver> solver = FastSolver::for_topology(sim.topology());
+                REQUIRE(solver);
+                State state = sim.state();
+                // A NaN particle in the first block of row 5 and one in the last block of row 9: the springs
+                // spread NaN to their neighbours substep by substep, and a box leaves them all out.
+                state.position.x[5 * cols + 3] = NAN;
+                state.position.z[9 * cols + cols - 1] = NAN;
+                const std::vector<std::size_t> start = block_starts(state.size(), cols, cols);
+                for (int substep = 0; substep < 4; ++substep) {
+                    const bool motion = substep % 2 == 1;  // the row update with and without the motion's bounds
+                    State plain = state;
+                    solver->step(plain, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, nullptr);
+                    std::vector<Box> boxes;
+                    MotionBounds bounds;
+                    solver->step(state, scene.settings, 7u, nullptr, sim.substep_length(), &boxes,
+                                 motion ? &bounds : nullptr);
+                    INFO(cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
+                              << " thread(s), substep " << substep);
+                    const std::size_t bytes = state.size() * sizeof(double);  // NaN != NaN: compare the bits
+                    CHECK(std::memcmp(state.position.x.data(), plain.position.x.data(), bytes) == 0);
+                    CHECK(std::memcmp(state.position.y.data(), plain.position.y.data(), bytes) == 0);
+                    CHECK(std::memcmp(state.position.z.data(), plain.position.z.data(), bytes) == 0);
+                    REQUIRE(boxes.size() + 1 == start.size());
+                    int mismatched = 0;
+                    for (std::size_t k = 0; k < boxes.size(); ++k) {
+                        const Box want = particle_bounds(state.position, start[k], start[k + 1]);
+                        if (!(boxes[k].lo == want.lo && boxes[k].hi == want.hi) || boxes[k].empty() != want.empty()) {
+                            ++mismatched;
+                        }
+                    }
+                    CHECK(mismatched == 0);
+                }
+                // The NaN has reached other particles, which the boxes above left out.
+                std::size_t nan = 0;
+                for (std::size_t i = 0; i < state.size(); ++i) nan += std::isnan(state.position.x[i]) ? 1 : 0;
+                CHECK(nan > 1);
+            }
+        }
+        FastSolver::use_kernel(was);
+    }
+}

@@ -33,6 +33,28 @@ MassSpring run(Scene scene, SolverMethod method, int threads, long long substeps
     return sim;
 }
 
+// `scene` resized to cols x cols, after 20 steps (a cloth whose particles move differently), and a fast solver
+// for its grid.
+std::pair<MassSpring, FastSolver> moving(Scene scene, int cols) {
+    scene.cloth.rows = scene.cloth.cols = cols;
+    MassSpring sim = build_simulation(scene);
+    sim.run_steps(20);
+    std::optional<FastSolver> solver = FastSolver::for_topology(sim.topology());
+    REQUIRE(solver);
+    return {std::move(sim), std::move(*solver)};
+}
+
+// Runs `check` once with each kernel this CPU runs in use, then puts back the one in use before.
+template <class Check>
+void with_every_kernel(Check check) {
+    const FastKernel best = FastSolver::best_kernel();
+    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
+        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
+        const FastKernel was = FastSolver::use_kernel(kernel);
+        check();
+        FastSolver::use_kernel(was);
+    }
+}
 
 }  // namespace
 
@@ -321,10 +343,7 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
 
 TEST_CASE("fast solver: the motion bounds its sweep takes are those of every particle's new motion, for every kernel "
           "and thread count, and taking them changes no position", "[fast_solver]") {
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-        const FastKernel was = FastSolver::use_kernel(kernel);
+    with_every_kernel([] {
         // drape-sphere in its per-spring form (a sagging, swinging cloth whose motions differ per particle, no
         // pins) and hanging in its material form (pinned corners, bends). 40 columns take the row update's
         // vector loop and its tail with AVX-512 (16 columns a vector), the vector loop alone with AVX2 and the
@@ -332,13 +351,9 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
         for (const auto& [name, cols] : {std::pair{"drape-sphere", 40}, std::pair{"drape-sphere", 13},
                                          std::pair{"hanging", 21}, std::pair{"hanging", 40}}) {
             Scene scene = std::string(name) == "hanging" ? load_scene(name) : per_spring_scene(name);
-            scene.cloth.rows = scene.cloth.cols = cols;
-            MassSpring sim = build_simulation(scene);
-            sim.run_steps(20);
+            auto [sim, solver] = moving(scene, cols);
             for (int threads : {1, 3}) {
                 scene.settings.solver.threads = threads;
-                std::optional<FastSolver> solver = FastSolver::for_topology(sim.topology());
-                REQUIRE(solver);
                 State state = sim.state();
                 // A force on every particle besides the springs' (the row update's form with external forces).
                 Vec3Array external;
@@ -347,9 +362,9 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
                 for (int substep = 0; substep < 6; ++substep) {
                     const Vec3Array* ext = substep % 2 ? &external : nullptr;
                     State plain = state;  // the same substep without the bounds
-                    solver->step(plain, scene.settings, 7u, ext, sim.substep_length(), nullptr, nullptr);
+                    solver.step(plain, scene.settings, 7u, ext, sim.substep_length(), nullptr, nullptr);
                     MotionBounds b;
-                    solver->step(state, scene.settings, 7u, ext, sim.substep_length(), nullptr, &b);
+                    solver.step(state, scene.settings, 7u, ext, sim.substep_length(), nullptr, &b);
                     INFO(name << " " << cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
                               << " thread(s), substep " << substep);
                     CHECK(state.position == plain.position);
@@ -364,28 +379,20 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
                 }
             }
         }
-        FastSolver::use_kernel(was);
-    }
+    });
 }
 
 TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of every block after the update, NaN "
           "particles left out, for every kernel and thread count, and taking them changes no position",
           "[fast_solver][broad_phase]") {
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-        const FastKernel was = FastSolver::use_kernel(kernel);
+    with_every_kernel([] {
         // 48 columns: three whole blocks of kBlockParticles (16); 40: two and a partial one; 13: a partial block
         // alone. Substeps alternate the row update with and without the motion's bounds (its two loops).
         for (int cols : {48, 40, 13}) {
             Scene scene = per_spring_scene("drape-sphere");
-            scene.cloth.rows = scene.cloth.cols = cols;
-            MassSpring sim = build_simulation(scene);
-            sim.run_steps(20);
+            auto [sim, solver] = moving(scene, cols);
             for (int threads : {1, 3}) {
                 scene.settings.solver.threads = threads;
-                std::optional<FastSolver> solver = FastSolver::for_topology(sim.topology());
-                REQUIRE(solver);
                 State state = sim.state();
                 // A NaN particle in the first block of row 5 and one in the last block of row 9: the springs
                 // spread NaN to their neighbours substep by substep, and a box leaves them all out.
@@ -395,10 +402,10 @@ TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of 
                 for (int substep = 0; substep < 4; ++substep) {
                     const bool motion = substep % 2 == 1;  // the row update with and without the motion's bounds
                     State plain = state;
-                    solver->step(plain, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, nullptr);
+                    solver.step(plain, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, nullptr);
                     std::vector<Box> boxes;
                     MotionBounds bounds;
-                    solver->step(state, scene.settings, 7u, nullptr, sim.substep_length(), &boxes,
+                    solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), &boxes,
                                  motion ? &bounds : nullptr);
                     INFO(cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
                               << " thread(s), substep " << substep);
@@ -422,6 +429,5 @@ TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of 
                 CHECK(nan > 1);
             }
         }
-        FastSolver::use_kernel(was);
-    }
+    });
 }

@@ -71,8 +71,8 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
 }
 
 // Eight springs from their differences: the AVX2 kernel's float arithmetic (forces16 is the same in 512-bit
-// vectors). With `tail` (a run's last 1 to 7 springs) the rest lengths are read and the forces written in its lanes only; the others
-// compute on zeros and are dropped.
+// vectors). With `tail` (a run's last 1 to 7 springs) the rest lengths are read and the forces written in
+// its lanes only; the others compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void forces8(__m256 dx, __m256 dy, __m256 dz,
                                                                                 const float* rest, float k,
                                                                                 float* fx, float* fy, float* fz,

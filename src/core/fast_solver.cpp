@@ -119,16 +119,17 @@ struct DoubleHalves {
     const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(load4(p + i + offset + 4, m1), load4(p + i + 4, m1)));
     return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
 }
+// Eight doubles from p, or only the `lanes` (the others read as zero).
+[[gnu::always_inline]] __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m512d load8(const double* p,
+                                                                                                  __mmask8 lanes) {
+    return lanes == 0xFF ? _mm512_loadu_pd(p) : _mm512_maskz_loadu_pd(lanes, p);
+}
 // ... one 8-wide subtraction and conversion with AVX-512; with `lanes` less than all eight, only those lanes'
 // positions are read (the others are zero).
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m256 difference8_avx512(
     const double* p, int i, int offset, __mmask8 lanes = 0xFF) {
     // maskz with all lanes: _mm512_cvtpd_ps itself trips GCC 12's -Wmaybe-uninitialized in its header.
-    if (lanes != 0xFF) {
-        return _mm512_maskz_cvtpd_ps(
-            0xFF, _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p + i + offset), _mm512_maskz_loadu_pd(lanes, p + i)));
-    }
-    return _mm512_maskz_cvtpd_ps(0xFF, _mm512_sub_pd(_mm512_loadu_pd(p + i + offset), _mm512_loadu_pd(p + i)));
+    return _mm512_maskz_cvtpd_ps(0xFF, _mm512_sub_pd(load8(p + i + offset, lanes), load8(p + i, lanes)));
 }
 
 // The AVX2 kernel: eight springs at a time, the last 1 to 7 in masked lanes.
@@ -177,13 +178,9 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, con
 // only those lanes' positions are read (the others are zero).
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) inline __m512 difference16_avx512(
     const double* p, int i, int offset, __mmask16 lanes = 0xFFFF) {
-    if (lanes != 0xFFFF) {
-        return _mm512_insertf32x8(
-            _mm512_castps256_ps512(difference8_avx512(p, i, offset, static_cast<__mmask8>(lanes))),
-            difference8_avx512(p, i + 8, offset, static_cast<__mmask8>(lanes >> 8)), 1);
-    }
-    return _mm512_insertf32x8(_mm512_castps256_ps512(difference8_avx512(p, i, offset)),
-                              difference8_avx512(p, i + 8, offset), 1);
+    return _mm512_insertf32x8(
+        _mm512_castps256_ps512(difference8_avx512(p, i, offset, static_cast<__mmask8>(lanes))),
+        difference8_avx512(p, i + 8, offset, static_cast<__mmask8>(lanes >> 8)), 1);
 }
 
 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) void spring_forces_avx512(
@@ -258,6 +255,22 @@ __attribute__((target("avx2,fma"))) void bend_forces_avx2(const double* x, const
         bends8_avx2(p, i, offset, vk, out, &lanes);
     }
 }
+// Eight bends from i with AVX-512; with `lanes` less than all eight (a run's last 1 to 7), only those lanes
+// are read and written.
+[[gnu::always_inline]] __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline void bends8_avx512(
+    const double* const p[3], int i, int offset, __m256 vk, float* const out[3], __mmask8 lanes = 0xFF) {
+    for (int c = 0; c < 3; ++c) {
+        const __m512d m = load8(p[c] + i + offset, lanes);
+        const __m512d d =
+            _mm512_add_pd(_mm512_sub_pd(load8(p[c] + i, lanes), m), _mm512_sub_pd(load8(p[c] + i + 2 * offset, lanes), m));
+        const __m256 e = _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d));
+        if (lanes == 0xFF) {
+            _mm256_storeu_ps(out[c], e);
+        } else {
+            _mm256_mask_storeu_ps(out[c], lanes, e);
+        }
+    }
+}
 __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(const double* x, const double* y,
                                                                              const double* z, int offset, int begin,
                                                                              int end, float k, float* fx, float* fy,
@@ -266,23 +279,12 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(con
     const double* const p[3] = {x, y, z};
     int i = begin;
     for (; i + 8 <= end; i += 8) {
-        for (int c = 0; c < 3; ++c) {
-            const __m512d m = _mm512_loadu_pd(p[c] + i + offset);
-            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_loadu_pd(p[c] + i), m),
-                                            _mm512_sub_pd(_mm512_loadu_pd(p[c] + i + 2 * offset), m));
-            _mm256_storeu_ps((c == 0 ? fx : c == 1 ? fy : fz) + (i - begin),
-                             _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
-        }
+        float* const out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        bends8_avx512(p, i, offset, vk, out);
     }
-    if (i < end) {  // the last 1 to 7 bends, in masked lanes (the others read nothing and are not written)
-        const auto lanes = static_cast<__mmask8>((1u << (end - i)) - 1u);
-        for (int c = 0; c < 3; ++c) {
-            const __m512d m = _mm512_maskz_loadu_pd(lanes, p[c] + i + offset);
-            const __m512d d = _mm512_add_pd(_mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i), m),
-                                            _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, p[c] + i + 2 * offset), m));
-            _mm256_mask_storeu_ps((c == 0 ? fx : c == 1 ? fy : fz) + (i - begin), lanes,
-                                  _mm256_mul_ps(vk, _mm512_maskz_cvtpd_ps(0xFF, d)));
-        }
+    if (i < end) {  // the last 1 to 7 bends, in masked lanes
+        float* const out[3] = {fx + (i - begin), fy + (i - begin), fz + (i - begin)};
+        bends8_avx512(p, i, offset, vk, out, static_cast<__mmask8>((1u << (end - i)) - 1u));
     }
 }
 

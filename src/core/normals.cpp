@@ -1,5 +1,7 @@
 #include "clothsim/normals.hpp"
 
+#include "fast_solver.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -38,13 +40,16 @@ struct CellRow {
     }
 };
 
-void cell_row(const DVec3Array& position, int cols, int r, CellRow& out) {
+[[gnu::always_inline]] inline void cell_row(const DVec3Array& position, int cols, int r, CellRow& out) {
     const std::size_t top = static_cast<std::size_t>(r) * cols, bottom = top + cols;
     const double* p[3] = {position.x.data(), position.y.data(), position.z.data()};
     float* f[3] = {out.first[0].data(), out.first[1].data(), out.first[2].data()};
     float* s[3] = {out.second[0].data(), out.second[1].data(), out.second[2].data()};
     const double *x0 = p[0] + top, *y0 = p[1] + top, *z0 = p[2] + top;
     const double *x1 = p[0] + bottom, *y1 = p[1] + bottom, *z1 = p[2] + bottom;
+    // The six output rows are distinct vectors: without the pragma GCC wants more alias checks than it will
+    // emit and leaves the loop scalar.
+#pragma GCC ivdep
     for (int c = 0; c + 1 < cols; ++c) {
         // first: e = p01 - p00, g = p10 - p00; second: e = p11 - p01, g = p10 - p01 (glm::cross's order).
         const float ex = static_cast<float>(x0[c + 1] - x0[c]), ey = static_cast<float>(y0[c + 1] - y0[c]),
@@ -69,8 +74,8 @@ void cell_row(const DVec3Array& position, int cols, int r, CellRow& out) {
 // cell (r-1, c)'s first and second, cell (r, c-1)'s first and second, cell (r, c)'s first. Inner vertices
 // of inner rows take a branch-free loop over structure-of-arrays rows (vectorised); the rest the general
 // sum, which skips the cells that do not exist.
-void grid_rows(const Topology& topology, const DVec3Array& position, int begin, int end,
-               std::vector<glm::vec3>& normals) {
+[[gnu::always_inline]] inline void grid_rows_body(const Topology& topology, const DVec3Array& position, int begin,
+                                                  int end, std::vector<glm::vec3>& normals) {
     const int rows = topology.rows, cols = topology.cols;
     CellRow above, below;
     above.resize(cols - 1);
@@ -133,6 +138,30 @@ void grid_rows(const Topology& topology, const DVec3Array& position, int begin, 
             general(cols - 1);
         }
         std::swap(above, below);
+    }
+}
+
+// grid_rows_body compiled for each instruction set, chosen as the fast solver chooses its kernels
+// (FastSolver::kernel). The core compiles without contraction into fused multiply-adds and every operation is
+// element-wise IEEE, so all three give the triangle list's normals bit for bit.
+void grid_rows_generic(const Topology& topology, const DVec3Array& position, int begin, int end,
+                       std::vector<glm::vec3>& normals) {
+    grid_rows_body(topology, position, begin, end, normals);
+}
+__attribute__((target("avx2,fma"))) void grid_rows_avx2(const Topology& topology, const DVec3Array& position,
+                                                         int begin, int end, std::vector<glm::vec3>& normals) {
+    grid_rows_body(topology, position, begin, end, normals);
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma,prefer-vector-width=512"))) void grid_rows_avx512(
+    const Topology& topology, const DVec3Array& position, int begin, int end, std::vector<glm::vec3>& normals) {
+    grid_rows_body(topology, position, begin, end, normals);
+}
+void grid_rows(const Topology& topology, const DVec3Array& position, int begin, int end,
+               std::vector<glm::vec3>& normals) {
+    switch (FastSolver::kernel()) {
+        case FastKernel::Avx512: grid_rows_avx512(topology, position, begin, end, normals); break;
+        case FastKernel::Avx2: grid_rows_avx2(topology, position, begin, end, normals); break;
+        case FastKernel::Generic: grid_rows_generic(topology, position, begin, end, normals); break;
     }
 }
 

@@ -3,7 +3,7 @@
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
-#include "fast_solver.hpp"
+#include "every_kernel.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -119,17 +119,13 @@ TEST_CASE("cloth shape: a disc runs on the fast solver bit for bit with the text
         for (std::size_t i = 0; i < start.particle_count(); ++i) {
             if (start.state().pinned[i] == kAbsent) CHECK(textbook.state().position.get(i) == start.state().position.get(i));
         }
-        const FastKernel best = FastSolver::best_kernel();
-        for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-            if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-            const FastKernel was = FastSolver::use_kernel(kernel);
+        test::with_every_kernel([&] {
             for (int threads : {1, 2}) {
                 INFO((material ? "material" : "per spring") << ", kernel " << FastSolver::kernel_name() << ", "
                                                             << threads << " threads");
                 CHECK(test::bit_identical(run(SolverMethod::Fast, threads), textbook));
             }
-            FastSolver::use_kernel(was);
-        }
+        });
     }
 }
 

@@ -1,5 +1,6 @@
 // The fast solver against the textbook solver (the oracle), determinism across thread counts, and
 // the fallbacks (generic kernel, non-grid topologies).
+#include "every_kernel.hpp"
 #include "fast_solver.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
@@ -47,23 +48,6 @@ std::pair<MassSpring, FastSolver> moving(Scene scene, int cols) {
     return {std::move(sim), std::move(*solver)};
 }
 
-// Runs `check` once with each kernel this CPU runs in use, then puts back the one in use before (also when a
-// REQUIRE throws).
-template <class Check>
-void with_every_kernel(Check check) {
-    struct Restore {
-        FastKernel was;
-        ~Restore() { FastSolver::use_kernel(was); }
-    };
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
-        const Restore restore{FastSolver::use_kernel(kernel)};
-        REQUIRE(FastSolver::kernel() == kernel);
-        check();
-    }
-}
-
 }  // namespace
 
 TEST_CASE("fast solver agrees with the textbook solver to 1e-5 of the cloth size after 1000 steps", "[fast_solver]") {
@@ -86,11 +70,7 @@ TEST_CASE("fast solver agrees with the textbook solver to 1e-5 of the cloth size
 }
 
 TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solver bit for bit", "[fast_solver]") {
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
-        const FastKernel was = FastSolver::use_kernel(kernel);
-        REQUIRE(FastSolver::kernel() == kernel);
+    test::with_every_kernel([] {
         // Per spring: the skip-one springs' sweeps (the material's bends with every kernel: the next test).
         for (const char* name : {"hanging", "drape-sphere", "flag"}) {
             const Scene scene = per_spring_scene(name);
@@ -99,8 +79,7 @@ TEST_CASE("fast solver: every kernel this CPU runs agrees with the textbook solv
             INFO(name << " with the " << FastSolver::kernel_name() << " kernel");
             CHECK(test::bit_identical(fast, textbook));
         }
-        FastSolver::use_kernel(was);
-    }
+    });
 }
 
 TEST_CASE("fast solver: a material cloth (bends, half-weight edges, warp and weft) agrees with the textbook solver "
@@ -118,17 +97,13 @@ TEST_CASE("fast solver: a material cloth (bends, half-weight edges, warp and wef
     const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 300);
     REQUIRE(textbook.bend_count() > 0);
     REQUIRE(textbook.all_finite());
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-        const FastKernel was = FastSolver::use_kernel(kernel);
+    test::with_every_kernel([&] {
         for (int threads : {1, 2, 5}) {
             const MassSpring fast = run(scene, SolverMethod::Fast, threads, 300);
             INFO("kernel " << FastSolver::kernel_name() << ", " << threads << " threads");
             CHECK(test::bit_identical(fast, textbook));
         }
-        FastSolver::use_kernel(was);
-    }
+    });
 }
 
 TEST_CASE("fast solver gives bit-identical positions for any thread count", "[fast_solver]") {
@@ -351,7 +326,7 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
 
 TEST_CASE("fast solver: the motion bounds its sweep takes are those of every particle's new motion, for every kernel "
           "and thread count, and taking them changes no position", "[fast_solver]") {
-    with_every_kernel([] {
+    test::with_every_kernel([] {
         // drape-sphere in its per-spring form (a sagging, swinging cloth whose motions differ per particle, no
         // pins) and hanging in its material form (pinned corners, bends). 40 columns take the row update's
         // vector loop and its tail with AVX-512 (16 columns a vector), the vector loop alone with AVX2 and the
@@ -393,7 +368,7 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
 TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of every block after the update, NaN "
           "particles left out, for every kernel and thread count, and taking them changes no position",
           "[fast_solver][broad_phase]") {
-    with_every_kernel([] {
+    test::with_every_kernel([] {
         // 48 columns: three whole blocks of kBlockParticles (16); 40: two and a partial one; 13: a partial block
         // alone. Substeps alternate the row update with and without the motion's bounds (its two loops).
         for (int cols : {48, 40, 13}) {

@@ -1,7 +1,7 @@
 // XPBD's grid form (grid_xpbd.hpp) against its exact oracle (the list-order XPBD on the same elements listed in
 // the grid's order), across kernels; and the physics it must keep: momentum, pins, convergence to the spring
 // model as the substeps grow.
-#include "fast_solver.hpp"
+#include "every_kernel.hpp"
 #include "grid_xpbd.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
@@ -101,7 +101,6 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         // The bundled scene that runs XPBD, on the grid of the simulation loops (support.hpp).
         {"stiff-drape", test::scene_for_loops("stiff-drape")},
     };
-    const FastKernel best = FastSolver::best_kernel();
     for (const auto& [name, scene] : cases) {
         const MassSpring built = build_simulation(scene);
         SimulationSettings textbook_settings = built.settings();  // a material's springs as derived on the grid
@@ -109,9 +108,7 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         MassSpring oracle(in_grid_order(built), built.state(), textbook_settings);
         oracle.run_steps(40);
         REQUIRE(oracle.all_finite());
-        for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-            if (static_cast<int>(kernel) > static_cast<int>(best)) continue;  // this CPU cannot run it
-            const FastKernel was = FastSolver::use_kernel(kernel);
+        test::with_every_kernel([&] {
             for (int threads : {1, 2, 3}) {
                 Scene threaded = scene;
                 threaded.settings.solver.threads = threads;
@@ -124,8 +121,7 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
                 CHECK(grid.last_solver_residual() == Approx(oracle.last_solver_residual()).epsilon(1e-9));
                 CHECK(grid.last_solver_residual() > 0.0);
             }
-            FastSolver::use_kernel(was);
-        }
+        });
         // And it is another order than the list's: the list-order XPBD differs (the test above means something).
         Scene list = scene;
         list.settings.solver.method = SolverMethod::Textbook;
@@ -149,17 +145,13 @@ TEST_CASE("grid XPBD reports the list order's residual on the bundled stiff-drap
     MassSpring oracle(in_grid_order(built), built.state(), textbook_settings);
     oracle.run_steps(3);
     REQUIRE(oracle.last_solver_residual() > 0.0);
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-        const FastKernel was = FastSolver::use_kernel(kernel);
+    test::with_every_kernel([&] {
         MassSpring grid = build_simulation(scene);
         grid.run_steps(3);
         INFO("the " << FastSolver::kernel_name() << " kernel");
         CHECK(same_state(grid, oracle));
         CHECK(grid.last_solver_residual() == Approx(oracle.last_solver_residual()).epsilon(1e-9));
-        FastSolver::use_kernel(was);
-    }
+    });
 }
 
 TEST_CASE("grid XPBD keeps the centre of mass of a free cloth without external forces", "[xpbd][grid]") {

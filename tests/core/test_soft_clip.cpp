@@ -6,7 +6,7 @@
 #include "clothsim/step_plan.hpp"
 #include "clothsim/strain.hpp"
 
-#include "fast_solver.hpp"
+#include "every_kernel.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
@@ -181,10 +181,7 @@ TEST_CASE("soft clip: without damping the energy, the holds' included, is conser
 
 TEST_CASE("soft clip: the fast solver agrees with the textbook solver bit for bit, every kernel and thread count",
           "[soft_clip][fast_solver]") {
-    const FastKernel best = FastSolver::best_kernel();
-    for (FastKernel kernel : {FastKernel::Generic, FastKernel::Avx2, FastKernel::Avx512}) {
-        if (static_cast<int>(kernel) > static_cast<int>(best)) continue;
-        const FastKernel was = FastSolver::use_kernel(kernel);
+    test::with_every_kernel([] {
         for (int threads : {1, 2}) {
             Scene s = hanging_clipped(24, ClipHold::Soft);
             s.settings.solver.threads = threads;
@@ -208,8 +205,7 @@ TEST_CASE("soft clip: the fast solver agrees with the textbook solver bit for bi
             textbook.run_steps(5);
             CHECK(test::bit_identical(fast, textbook));
         }
-        FastSolver::use_kernel(was);
-    }
+    });
 }
 
 TEST_CASE("soft clip: the critical substep counts the holds, and sets it where the springs are implicit",

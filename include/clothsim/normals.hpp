@@ -11,8 +11,8 @@
 namespace clothsim {
 
 // Resizes `normals` to the particle count. A grid whose triangles are Topology::cell_triangles is swept by
-// rows of cells (vectorised; threaded from 128 x 128 on) with the same sums in the same order as the
-// triangle list, so both give the same bits. A particle in no triangle (a 1 x N chain) gets u x v of nothing:
+// rows of cells (vectorised with the fast solver's kernel, FastSolver::kernel; threaded from 128 x 128 on)
+// with the same sums in the same order as the triangle list, so both give the same bits. A particle in no triangle (a 1 x N chain) gets u x v of nothing:
 // (0, 1, 0), so the renderer never normalises a zero vector.
 void compute_vertex_normals(const Topology& topology, const DVec3Array& position, std::vector<glm::vec3>& normals);
 

@@ -119,7 +119,8 @@ struct CellRow {
                 const float* bs = below.second[k].data();
                 float* n = sum[k].data();
                 for (int c = 1; c + 1 < cols; ++c) {
-                    n[c] = as[c - 1] + af[c] + as[c] + bf[c - 1] + bs[c - 1] + bf[c];  // 0 + a is a: no first add
+                    // From 0, as the list's sum starts: 0 + a is a except for a = -0 (0 + -0 = +0).
+                    n[c] = 0.0f + as[c - 1] + af[c] + as[c] + bf[c - 1] + bs[c - 1] + bf[c];
                 }
             }
             // unit_or_up, as arrays: the same sqrt of ((x x + y y) + z z) and the same divides.
@@ -156,13 +157,14 @@ __attribute__((target("avx512f,avx512vl,avx2,fma,prefer-vector-width=512"))) voi
     const Topology& topology, const DVec3Array& position, int begin, int end, std::vector<glm::vec3>& normals) {
     grid_rows_body(topology, position, begin, end, normals);
 }
-void grid_rows(const Topology& topology, const DVec3Array& position, int begin, int end,
-               std::vector<glm::vec3>& normals) {
+using GridRows = void (*)(const Topology&, const DVec3Array&, int, int, std::vector<glm::vec3>&);
+GridRows grid_rows_kernel() {
     switch (FastSolver::kernel()) {
-        case FastKernel::Avx512: grid_rows_avx512(topology, position, begin, end, normals); break;
-        case FastKernel::Avx2: grid_rows_avx2(topology, position, begin, end, normals); break;
-        case FastKernel::Generic: grid_rows_generic(topology, position, begin, end, normals); break;
+        case FastKernel::Avx512: return grid_rows_avx512;
+        case FastKernel::Avx2: return grid_rows_avx2;
+        case FastKernel::Generic: break;
     }
+    return grid_rows_generic;
 }
 
 }  // namespace
@@ -176,6 +178,8 @@ void compute_vertex_normals(const Topology& topology, const DVec3Array& position
         return;
     }
     normals.resize(position.size());  // every vertex is written below
+    if (position.size() == 0) return;
+    const GridRows grid_rows = grid_rows_kernel();
     // Row blocks, one per thread from 128 rows of 128 on (below that a team costs more than it saves); each
     // block recomputes the one cell row above it, so no two threads write the same vertex.
     static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));

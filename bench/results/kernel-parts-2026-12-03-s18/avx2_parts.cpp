@@ -1,5 +1,6 @@
 // The AVX2 spring kernel's parts per spring, L1-resident rows: double differences (today), float differences
-// (the float-state build), and hi + lo float differences (positions as two floats).
+// (the float-state build), hi + lo float differences (positions as two floats) and int32 differences
+// (positions in fixed point, 2^-30 m, relative to an origin).
 // Not part of the build (docs/PERFORMANCE.md, session 18): g++ -O2 -std=c++20 -I include \
 //     bench/results/kernel-parts-2026-12-03-s18/avx2_parts.cpp -o /tmp/avx2_parts && /tmp/avx2_parts
 #include <immintrin.h>
@@ -34,7 +35,10 @@ T AI void forces8(__m256 dx, __m256 dy, __m256 dz, const float* rest, float k, f
     _mm256_storeu_ps(fy, _mm256_mul_ps(s, dy));
     _mm256_storeu_ps(fz, _mm256_mul_ps(s, dz));
 }
-struct Data { int n; AlignedVector<double> x, y, z; AlignedVector<float> xf, yf, zf, xl, yl, zl, rest, fx, fy, fz; };
+struct Data { int n; AlignedVector<double> x, y, z; AlignedVector<float> xf, yf, zf, xl, yl, zl, rest, fx, fy, fz; AlignedVector<int> xi, yi, zi; };
+T AI __m256 diffi(const int* p, int i, int o, __m256 scale) {  // fixed point: (q_b - q_a) exactly in int32, then one rounding
+    return _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_loadu_si256((const __m256i*)(p + i + o)), _mm256_loadu_si256((const __m256i*)(p + i)))), scale);
+}
 T __attribute__((noinline)) void run_d(Data& d, int o) {
     for (int i = 0; i + 8 <= d.n; i += 8)
         forces8(diffd(d.x.data(), i, o), diffd(d.y.data(), i, o), diffd(d.z.data(), i, o), d.rest.data() + i, 1000.f, d.fx.data() + i, d.fy.data() + i, d.fz.data() + i);
@@ -46,6 +50,11 @@ T __attribute__((noinline)) void run_f(Data& d, int o) {
 T __attribute__((noinline)) void run_hl(Data& d, int o) {
     for (int i = 0; i + 8 <= d.n; i += 8)
         forces8(diffhl(d.xf.data(), d.xl.data(), i, o), diffhl(d.yf.data(), d.yl.data(), i, o), diffhl(d.zf.data(), d.zl.data(), i, o), d.rest.data() + i, 1000.f, d.fx.data() + i, d.fy.data() + i, d.fz.data() + i);
+}
+T __attribute__((noinline)) void run_i(Data& d, int o) {
+    const __m256 sc = _mm256_set1_ps(std::ldexp(1.0f, -30));
+    for (int i = 0; i + 8 <= d.n; i += 8)
+        forces8(diffi(d.xi.data(), i, o, sc), diffi(d.yi.data(), i, o, sc), diffi(d.zi.data(), i, o, sc), d.rest.data() + i, 1000.f, d.fx.data() + i, d.fy.data() + i, d.fz.data() + i);
 }
 template <class F> double ns_per_spring(F f, Data& d, int off = 1) {
     std::vector<double> t;
@@ -61,15 +70,17 @@ template <class F> double ns_per_spring(F f, Data& d, int off = 1) {
 int main() {
     Data d; d.n = 1024; int m = d.n + 32;
     for (auto* v : {&d.x, &d.y, &d.z}) v->resize(m);
+    for (auto* v : {&d.xi, &d.yi, &d.zi}) v->resize(m);
     for (auto* v : {&d.xf, &d.yf, &d.zf, &d.xl, &d.yl, &d.zl, &d.rest, &d.fx, &d.fy, &d.fz}) v->resize(m);
     for (int i = 0; i < m; ++i) {
         d.x[i] = 0.01 * i + 1e-4 * std::sin(i); d.y[i] = 1.5 + 1e-3 * std::cos(i); d.z[i] = 0.3 * std::sin(0.01 * i);
         d.xf[i] = d.x[i]; d.yf[i] = d.y[i]; d.zf[i] = d.z[i];
         d.xl[i] = d.x[i] - d.xf[i]; d.yl[i] = d.y[i] - d.yf[i]; d.zl[i] = d.z[i] - d.zf[i];
         d.rest[i] = 0.0099f;
+        d.xi[i] = int(std::ldexp(d.x[i] - 5.0, 30)); d.yi[i] = int(std::ldexp(d.y[i] - 1.5, 30)); d.zi[i] = int(std::ldexp(d.z[i], 30));
     }
     for (int round = 0; round < 5; ++round) {
-        const double a = ns_per_spring(run_d, d), b = ns_per_spring(run_f, d), c = ns_per_spring(run_hl, d);
-        std::printf("AVX2: double diffs %.3f | float diffs %.3f (%.2fx) | hi+lo diffs %.3f (%.2fx) ns/spring\n", a, b, a / b, c, a / c);
+        const double a = ns_per_spring(run_d, d), b = ns_per_spring(run_f, d), c = ns_per_spring(run_hl, d), e = ns_per_spring(run_i, d);
+        std::printf("AVX2: double diffs %.3f | float diffs %.3f (%.2fx) | hi+lo diffs %.3f (%.2fx) | int32 fixed-point diffs %.3f (%.2fx) ns/spring\n", a, b, a / b, c, a / c, e, a / e);
     }
 }

@@ -142,7 +142,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(4, 64));
     stiff_precision->add_option("--set", sp.overrides,
                                 "KEY=VALUE scene field for every integrator but Verlet (e.g. integration.iterations=30)");
-    stiff_precision->add_option("--max-substeps", sp.max_substeps, "implicit-euler and xpbd: 1, 2, 4, ... up to this")
+    stiff_precision->add_option("--min-substeps", sp.min_substeps,
+                                "implicit-euler, xpbd and projective: start their doubling sweep here")
+        ->check(CLI::Range(1, kMaxSubsteps));
+    stiff_precision->add_option("--max-substeps", sp.max_substeps,
+                                "implicit-euler, xpbd and projective: MIN, 2 MIN, 4 MIN, ... up to this")
         ->check(CLI::Range(1, kMaxSubsteps));
     stiff_precision->add_option("--max-run-seconds", sp.max_run_seconds,
                                 "Skip a setting whose first step predicts more CPU seconds per simulated second")

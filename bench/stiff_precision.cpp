@@ -270,7 +270,7 @@ int run_stiff_precision(const StiffPrecisionOptions& options) {
                 for (int m : kStableMultiples) counts.push_back(m * stable_substeps);
                 counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
             } else {
-                for (int n = 1; n <= options.max_substeps; n *= 2) counts.push_back(n);
+                for (int n = options.min_substeps; n <= options.max_substeps; n *= 2) counts.push_back(n);
             }
             double spent = 0.0;
             for (std::size_t i = 0; i < counts.size(); ++i) {

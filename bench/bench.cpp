@@ -143,10 +143,10 @@ int main(int argc, char** argv) {
     stiff_precision->add_option("--set", sp.overrides,
                                 "KEY=VALUE scene field for every integrator but Verlet (e.g. integration.iterations=30)");
     stiff_precision->add_option("--min-substeps", sp.min_substeps,
-                                "implicit-euler, xpbd and projective: start their doubling sweep here")
+                                "Integrators that are not explicit (implicit-euler, xpbd, projective): start their doubling sweep here")
         ->check(CLI::Range(1, kMaxSubsteps));
     stiff_precision->add_option("--max-substeps", sp.max_substeps,
-                                "implicit-euler, xpbd and projective: MIN, 2 MIN, 4 MIN, ... up to this")
+                                "Integrators that are not explicit: MIN, 2 MIN, 4 MIN, ... up to this")
         ->check(CLI::Range(1, kMaxSubsteps));
     stiff_precision->add_option("--max-run-seconds", sp.max_run_seconds,
                                 "Skip a setting whose first step predicts more CPU seconds per simulated second")

@@ -176,6 +176,12 @@ Row measure(int side, const std::string& integrator, int substeps, double critic
 }  // namespace
 
 int run_stiff_precision(const StiffPrecisionOptions& options) {
+    if (options.min_substeps > options.max_substeps) {
+        std::fprintf(stderr, "clothsim-bench stiff-precision: --min-substeps %d is above --max-substeps %d: the "
+                             "implicit integrators would run no setting\n",
+                     options.min_substeps, options.max_substeps);
+        return 2;
+    }
     overrides = options.overrides;
     std::ofstream csv;
     if (!open_csv(options.csv,

@@ -19,7 +19,7 @@ struct StiffPrecisionOptions {
     std::vector<std::string> integrators{"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd", "projective"};
     int repeats = 3;                  // timed repetitions of each setting (median)
     int reference_factor = 8;         // the reference's substeps: this times the stable count
-    int min_substeps = 1;             // implicit-euler, xpbd and projective run min, 2 min, 4 min, ...
+    int min_substeps = 1;             // integrators that are not explicit run min, 2 min, 4 min, ...
     int max_substeps = 4096;          // ... up to this
     double max_run_seconds = 45.0;    // skip a setting whose first step predicts more CPU s per simulated second
     double max_sweep_seconds = 120.0; // stop an integrator's sweep at one size once its runs took this long

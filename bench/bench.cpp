@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
         std::vector<glm::vec3> normals, positions;
         const double prep = median_seconds(
             [&] {
-                positions = sim.positions();
+                sim.positions(positions);
                 compute_vertex_normals(sim.topology(), sim.state().position, normals);
             },
             repeats, min_seconds);

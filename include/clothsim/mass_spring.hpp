@@ -93,6 +93,9 @@ public:
     // Positions rounded to float, as the renderer and exports use them; state() has them in double.
     glm::vec3 position(std::size_t i) const { return glm::vec3(state_.position.get(i)); }
     std::vector<glm::vec3> positions() const;
+    // The same into `out`, resized to the particle count: a caller that keeps `out` (the renderer, each
+    // frame) reuses its memory instead of allocating and zero-filling a new array.
+    void positions(std::vector<glm::vec3>& out) const;
     // Second-order velocity estimates at the current positions (m/s), rounded to float.
     std::vector<glm::vec3> velocities() const;
     Energy energy() const;

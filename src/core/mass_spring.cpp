@@ -615,9 +615,14 @@ Particle MassSpring::particle(std::size_t i) const {
 }
 
 std::vector<glm::vec3> MassSpring::positions() const {
-    std::vector<glm::vec3> p(state_.size());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = glm::vec3(state_.position.get(i));
+    std::vector<glm::vec3> p;
+    positions(p);
     return p;
+}
+
+void MassSpring::positions(std::vector<glm::vec3>& out) const {
+    out.resize(state_.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec3(state_.position.get(i));
 }
 
 std::vector<glm::vec3> MassSpring::velocities() const {

@@ -151,7 +151,7 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
     }
     const auto start = Clock::now();
     const Topology& t = sim.topology();
-    positions_ = sim.positions();
+    sim.positions(positions_);
     // A torn cloth is drawn split along its tears (cloth_surface.hpp): the split vertices follow the particles.
     const ClothSurface& surface = sim.surface();
     if (surface.split()) {

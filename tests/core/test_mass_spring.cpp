@@ -106,10 +106,35 @@ TEST_CASE("mass_spring the same scene run twice gives bit-identical positions", 
         const State& sa = a.state();
         const State& sb = b.state();
         REQUIRE(sa.size() == sb.size());
-        CHECK(std::memcmp(sa.position.x.data(), sb.position.x.data(), sa.size() * sizeof(float)) == 0);
-        CHECK(std::memcmp(sa.position.y.data(), sb.position.y.data(), sa.size() * sizeof(float)) == 0);
-        CHECK(std::memcmp(sa.position.z.data(), sb.position.z.data(), sa.size() * sizeof(float)) == 0);
+        CHECK(std::memcmp(sa.position.x.data(), sb.position.x.data(), sa.size() * sizeof(sa.position.x[0])) == 0);
+        CHECK(std::memcmp(sa.position.y.data(), sb.position.y.data(), sa.size() * sizeof(sa.position.x[0])) == 0);
+        CHECK(std::memcmp(sa.position.z.data(), sb.position.z.data(), sa.size() * sizeof(sa.position.x[0])) == 0);
     }
+}
+
+TEST_CASE("mass_spring positions into a kept array equal positions(), whatever the array held", "[mass_spring]") {
+    MassSpring sim = build_simulation(load_scene("drape-sphere"));
+    sim.run_steps(30);
+    const std::vector<glm::vec3> fresh = sim.positions();
+    REQUIRE(fresh.size() == sim.particle_count());
+    for (std::size_t i = 0; i < fresh.size(); ++i) {
+        REQUIRE(fresh[i] == glm::vec3(sim.state().position.get(i)));  // the double state rounded once
+    }
+    // Longer, shorter and empty arrays filled with NaN all end as the particles' positions.
+    for (std::size_t start : {fresh.size() + 7, fresh.size() / 2, std::size_t{0}, fresh.size()}) {
+        std::vector<glm::vec3> kept(start, glm::vec3(NAN));
+        sim.positions(kept);
+        REQUIRE(kept.size() == fresh.size());
+        CHECK(std::memcmp(kept.data(), fresh.data(), fresh.size() * sizeof(glm::vec3)) == 0);
+    }
+    // An array of the right size is written in place, not reallocated (the renderer's frame).
+    std::vector<glm::vec3> frame(fresh.size());
+    const glm::vec3* memory = frame.data();
+    sim.step();
+    sim.positions(frame);
+    CHECK(frame.data() == memory);
+    CHECK(frame == sim.positions());
+    CHECK(frame != fresh);  // the cloth moved
 }
 
 TEST_CASE("mass_spring zero-length springs and coincident particles stay finite", "[mass_spring]") {

@@ -1,5 +1,7 @@
 #include "clothsim/broad_phase.hpp"
 
+#include "fast_solver.hpp"
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -7,6 +9,8 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 
 namespace clothsim {
 namespace {
@@ -52,27 +56,126 @@ __attribute__((target("avx2"))) inline double hmax(__m256d v) {
     return _mm_cvtsd_f64(m);
 }
 
-// A whole row's blocks at once: full blocks of 16 are four vectors per axis and a shuffle reduction.
+// One full block's box (16 particles from `v`, per axis): four vectors per axis and a shuffle reduction.
+__attribute__((target("avx2"))) inline void block_bounds_avx2(const double* const axes[3], std::size_t c, Box& out) {
+    for (int a = 0; a < 3; ++a) {
+        const double* v = axes[a] + c;
+        // _mm256_min_pd(x, y) returns y when x is NaN, so starting from +inf NaNs drop out.
+        __m256d lo = _mm256_set1_pd(INFINITY), hi = _mm256_set1_pd(-INFINITY);
+        for (int k = 0; k < 16; k += 4) {
+            const __m256d x = _mm256_loadu_pd(v + k);
+            lo = _mm256_min_pd(x, lo);
+            hi = _mm256_max_pd(x, hi);
+        }
+        out.lo[a] = static_cast<float>(hmin(lo));
+        out.hi[a] = static_cast<float>(hmax(hi));
+    }
+}
+
+// A whole row's blocks at once, block by block.
 __attribute__((target("avx2"))) void row_bounds_avx2(const DVec3Array& position, std::size_t begin,
                                                       std::size_t count, Box* out) {
     const double* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
     std::size_t c = 0;
-    for (; c + 16 <= count; c += 16, ++out) {
-        for (int a = 0; a < 3; ++a) {
-            const double* v = axes[a] + c;
-            // _mm256_min_pd(x, y) returns y when x is NaN, so starting from +inf NaNs drop out.
-            __m256d lo = _mm256_set1_pd(INFINITY), hi = _mm256_set1_pd(-INFINITY);
-            for (int k = 0; k < 16; k += 4) {
-                const __m256d x = _mm256_loadu_pd(v + k);
-                lo = _mm256_min_pd(x, lo);
-                hi = _mm256_max_pd(x, hi);
-            }
-            out->lo[a] = static_cast<float>(hmin(lo));
-            out->hi[a] = static_cast<float>(hmax(hi));
-        }
-    }
+    for (; c + 16 <= count; c += 16, ++out) block_bounds_avx2(axes, c, *out);
     if (c < count) *out = particle_bounds(position, begin + c, begin + count);
 }
+
+#define CLOTHSIM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
+// maskz with all lanes throughout: the unmasked forms trip GCC 12's -Wuninitialized in its header.
+template <bool Max>
+CLOTHSIM_AVX512 [[gnu::always_inline]] inline __m512d bound(__m512d a, __m512d b) {
+    return Max ? _mm512_maskz_max_pd(0xFF, a, b) : _mm512_maskz_min_pd(0xFF, a, b);
+}
+// Eight blocks' bounds of one axis folded together: v[j] holds block j's bounds lane by lane (no NaN), and
+// three rounds of shuffles and minima (maxima) leave block k in lane 2k and block k + 4 in lane 2k + 1
+// (the transpose-and-reduce of eight vectors: 21 instructions, where one vector's own reduction takes 6).
+template <bool Max>
+CLOTHSIM_AVX512 [[gnu::always_inline]] inline __m512d fold8(const __m512d v[8]) {
+    __m512d s[4], u[2];
+    for (int p = 0; p < 4; ++p) {  // 128-bit chunks 0-1: block 2p's halves folded; chunks 2-3: block 2p + 1's
+        s[p] = bound<Max>(_mm512_maskz_shuffle_f64x2(0xFF, v[2 * p], v[2 * p + 1], _MM_SHUFFLE(1, 0, 1, 0)),
+                          _mm512_maskz_shuffle_f64x2(0xFF, v[2 * p], v[2 * p + 1], _MM_SHUFFLE(3, 2, 3, 2)));
+    }
+    for (int p = 0; p < 2; ++p) {  // chunk k: block 4p + k
+        u[p] = bound<Max>(_mm512_maskz_shuffle_f64x2(0xFF, s[2 * p], s[2 * p + 1], _MM_SHUFFLE(2, 0, 2, 0)),
+                          _mm512_maskz_shuffle_f64x2(0xFF, s[2 * p], s[2 * p + 1], _MM_SHUFFLE(3, 1, 3, 1)));
+    }
+    return bound<Max>(_mm512_maskz_unpacklo_pd(0xFF, u[0], u[1]), _mm512_maskz_unpackhi_pd(0xFF, u[0], u[1]));
+}
+
+// Where fold8 leaves block j of eight (lane 2k: block k, lane 2k + 1: block k + 4).
+constexpr int folded_lane(int j) { return j < 4 ? 2 * j : 2 * (j - 4) + 1; }
+
+// The permutes that write eight boxes (48 floats: lo.x, lo.y, lo.z, hi.x, hi.y, hi.z each) as three vectors of
+// sixteen from the folded bounds paired as [lo.x | lo.y], [lo.z | hi.x] and [hi.y | hi.z]: output float f is
+// box f / 6's bound f % 6, taken from pair (f % 6) / 2 at 8 ((f % 6) % 2) + folded_lane(f / 6).
+struct BoxPermutes {
+    // For each output vector: indices into the first two pairs (vpermt2ps: 0-15 the first, 16-31 the second),
+    // indices into the third, and the mask of the floats that come from the third.
+    std::array<std::array<int, 16>, 3> first_two{}, third{};
+    std::array<unsigned, 3> from_third{};
+};
+constexpr BoxPermutes box_permutes() {
+    BoxPermutes p;
+    for (int k = 0; k < 3; ++k) {
+        for (int t = 0; t < 16; ++t) {
+            const int f = 16 * k + t, box = f / 6, bound_of = f % 6;
+            const int index = 8 * (bound_of % 2) + folded_lane(box);
+            if (bound_of / 2 == 2) {
+                p.third[k][t] = index;
+                p.from_third[k] |= 1u << t;
+            } else {
+                p.first_two[k][t] = 16 * (bound_of / 2) + index;
+            }
+        }
+    }
+    return p;
+}
+constexpr BoxPermutes kBoxPermutes = box_permutes();
+static_assert(sizeof(Box) == 6 * sizeof(float), "eight boxes are written as 48 consecutive floats");
+
+// Eight full blocks' boxes from column c: per axis sixteen loads, each block's two vectors bounded lane by
+// lane from +-inf (_mm512_min_pd(x, y) returns y when x is NaN, so NaN coordinates drop out and the fold sees
+// none), folded (fold8), rounded to float and written with three permutes per vector of boxes.
+CLOTHSIM_AVX512 void eight_blocks_avx512(const double* const axes[3], std::size_t c, Box* out) {
+    __m256 bounds[6];  // lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of the eight blocks, in folded_lane order
+    for (int a = 0; a < 3; ++a) {
+        __m512d lo[8], hi[8];
+        for (int j = 0; j < 8; ++j) {
+            const double* v = axes[a] + c + 16 * j;
+            const __m512d x0 = _mm512_loadu_pd(v), x1 = _mm512_loadu_pd(v + 8);
+            lo[j] = bound<false>(x1, bound<false>(x0, _mm512_set1_pd(INFINITY)));
+            hi[j] = bound<true>(x1, bound<true>(x0, _mm512_set1_pd(-INFINITY)));
+        }
+        bounds[a] = _mm512_maskz_cvtpd_ps(0xFF, fold8<false>(lo));
+        bounds[3 + a] = _mm512_maskz_cvtpd_ps(0xFF, fold8<true>(hi));
+    }
+    const __m512 pairs[3] = {
+        _mm512_insertf32x8(_mm512_castps256_ps512(bounds[0]), bounds[1], 1),
+        _mm512_insertf32x8(_mm512_castps256_ps512(bounds[2]), bounds[3], 1),
+        _mm512_insertf32x8(_mm512_castps256_ps512(bounds[4]), bounds[5], 1),
+    };
+    auto* floats = reinterpret_cast<float*>(out);
+    for (int k = 0; k < 3; ++k) {
+        const __m512i first_two = _mm512_loadu_si512(kBoxPermutes.first_two[k].data());
+        const __m512i third = _mm512_loadu_si512(kBoxPermutes.third[k].data());
+        const __m512 v = _mm512_mask_permutexvar_ps(_mm512_permutex2var_ps(pairs[0], first_two, pairs[1]),
+                                                    static_cast<__mmask16>(kBoxPermutes.from_third[k]), third,
+                                                    pairs[2]);
+        _mm512_storeu_ps(floats + 16 * k, v);
+    }
+}
+
+// The row's blocks eight at a time, the rest of its full blocks one at a time, then the partial one.
+CLOTHSIM_AVX512 void row_bounds_avx512(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out) {
+    const double* axes[3] = {position.x.data() + begin, position.y.data() + begin, position.z.data() + begin};
+    std::size_t c = 0;
+    for (; c + 128 <= count; c += 128, out += 8) eight_blocks_avx512(axes, c, out);
+    for (; c + 16 <= count; c += 16, ++out) block_bounds_avx2(axes, c, *out);
+    if (c < count) *out = particle_bounds(position, begin + c, begin + count);
+}
+#undef CLOTHSIM_AVX512
 
 const bool kAvx2 = [] {
     __builtin_cpu_init();
@@ -112,11 +215,14 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
     bounds.empty = false;
 }
 
+// Chosen as the fast solver chooses its kernels (FastSolver::kernel), so the tests run each one this CPU has.
+// A minimum and a maximum round nothing: every kernel gives particle_bounds' boxes (up to the sign of a zero).
 void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out) {
-    static_assert(kBlockParticles == 16, "row_bounds_avx2 reduces two vectors per block");
-    if (kAvx2) {
-        row_bounds_avx2(position, begin, count, out);
-        return;
+    static_assert(kBlockParticles == 16, "the row kernels bound 16 particles per block");
+    switch (FastSolver::kernel()) {
+        case FastKernel::Avx512: row_bounds_avx512(position, begin, count, out); return;
+        case FastKernel::Avx2: row_bounds_avx2(position, begin, count, out); return;
+        case FastKernel::Generic: break;
     }
     for (std::size_t c = 0; c < count; c += kBlockParticles, ++out) {
         *out = particle_bounds(position, begin + c, begin + std::min(c + kBlockParticles, count));

@@ -1,5 +1,6 @@
 // The collision broad phase: boxes around particle blocks, and may_touch, which must be conservative (a
 // particle a collider would move always lies in a box the test accepts), or culling would change results.
+#include "every_kernel.hpp"
 #include "support.hpp"
 
 #include "clothsim/broad_phase.hpp"
@@ -184,15 +185,17 @@ TEST_CASE("broad_phase union_of is the box around its boxes, a NaN bound left ou
 
 TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles and row_block_bounds boxes them",
           "[broad_phase]") {
-    // A grid: every row on its own, cut into runs of at most kBlockParticles, in row order.
-    const int rows = 3, cols = static_cast<int>(2 * kBlockParticles + 5);
+    // A grid: every row on its own, cut into runs of at most kBlockParticles, in row order. A row holds two
+    // groups of eight full blocks (the AVX-512 kernel's unit), two more full blocks and a partial one.
+    const int rows = 3, cols = static_cast<int>(18 * kBlockParticles + 5);
+    const std::size_t per_row = blocks_per_row(cols);
     const std::size_t n = static_cast<std::size_t>(rows) * cols;
     const std::vector<std::size_t> starts = block_starts(n, rows, cols);
-    REQUIRE(blocks_per_row(cols) == 3);
-    REQUIRE(starts.size() == static_cast<std::size_t>(rows) * blocks_per_row(cols) + 1);
+    REQUIRE(per_row == 19);
+    REQUIRE(starts.size() == static_cast<std::size_t>(rows) * per_row + 1);
     for (int r = 0; r < rows; ++r) {
-        for (std::size_t j = 0; j < blocks_per_row(cols); ++j) {
-            CHECK(starts[r * blocks_per_row(cols) + j] == static_cast<std::size_t>(r) * cols + j * kBlockParticles);
+        for (std::size_t j = 0; j < per_row; ++j) {
+            CHECK(starts[r * per_row + j] == static_cast<std::size_t>(r) * cols + j * kBlockParticles);
         }
     }
     CHECK(starts.back() == n);
@@ -202,30 +205,40 @@ TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles 
     CHECK(list == std::vector<std::size_t>{0, kBlockParticles, 2 * kBlockParticles, 40});
     CHECK(block_starts(0, 0, 0) == std::vector<std::size_t>{0});
 
-    // The boxes of one row's blocks are those particle_bounds gives, NaN particles included.
+    // The boxes of one row's blocks are those particle_bounds gives, with every kernel: NaN particles in the
+    // first and last lane of a block, in the second group of eight, in the single blocks and in the partial
+    // one; a whole block of NaN particles in each group of eight (the empty box); infinite coordinates.
     std::mt19937 rng(4);
     DVec3Array p;
     p.resize(n);
     for (std::size_t i = 0; i < n; ++i) p.set(i, random_vec(rng, 3.0f));
-    for (std::size_t i : {std::size_t{1}, std::size_t{cols + 20u}, n - 1}) p.set(i, glm::vec3(NAN));
-    for (std::size_t i = static_cast<std::size_t>(cols); i < static_cast<std::size_t>(cols) + kBlockParticles; ++i) {
-        p.set(i, glm::vec3(NAN));  // a whole block of NaN particles: the empty box
+    const std::size_t row = static_cast<std::size_t>(cols);
+    for (std::size_t i : {std::size_t{1}, std::size_t{15}, std::size_t{16 * 9 + 7}, std::size_t{16 * 16 + 3},
+                          row + 16 * 17 + 15, n - 1, n - 4}) {
+        p.set(i, glm::vec3(NAN));
     }
-    std::vector<Box> boxes(blocks_per_row(cols));
-    for (int r = 0; r < rows; ++r) {
-        const std::size_t begin = static_cast<std::size_t>(r) * cols;
-        row_block_bounds(p, begin, static_cast<std::size_t>(cols), boxes.data());
-        for (std::size_t j = 0; j < boxes.size(); ++j) {
-            INFO("row " << r << ", block " << j);
-            const std::size_t b = starts[r * blocks_per_row(cols) + j], e = starts[r * blocks_per_row(cols) + j + 1];
-            const Box want = reference_bounds(p, b, e);
-            CHECK(boxes[j].empty() == want.empty());
-            if (want.empty()) continue;
-            CHECK(boxes[j].lo == want.lo);
-            CHECK(boxes[j].hi == want.hi);
+    p.x[2 * row + 40] = NAN;  // one coordinate only
+    p.y[2 * row + 41] = INFINITY;
+    p.z[2 * row + 16 * 12] = -INFINITY;
+    for (std::size_t i = row; i < row + kBlockParticles; ++i) p.set(i, glm::vec3(NAN));
+    for (std::size_t i = 2 * row + 16 * 13; i < 2 * row + 16 * 14; ++i) p.set(i, glm::vec3(NAN));
+    test::with_every_kernel([&] {
+        std::vector<Box> boxes(per_row);
+        for (int r = 0; r < rows; ++r) {
+            const std::size_t begin = static_cast<std::size_t>(r) * cols;
+            row_block_bounds(p, begin, static_cast<std::size_t>(cols), boxes.data());
+            for (std::size_t j = 0; j < boxes.size(); ++j) {
+                INFO(FastSolver::kernel_name(FastSolver::kernel()) << ": row " << r << ", block " << j);
+                const std::size_t b = starts[r * per_row + j], e = starts[r * per_row + j + 1];
+                const Box want = reference_bounds(p, b, e);
+                CHECK(boxes[j].empty() == want.empty());
+                if (want.empty()) continue;
+                CHECK(boxes[j].lo == want.lo);
+                CHECK(boxes[j].hi == want.hi);
+            }
         }
-    }
-    CHECK(particle_bounds(p, static_cast<std::size_t>(cols), static_cast<std::size_t>(cols) + kBlockParticles).empty());
+    });
+    CHECK(particle_bounds(p, row, row + kBlockParticles).empty());
 }
 
 TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the collider's centre",

@@ -69,7 +69,7 @@ private:
     FastSolver(int rows, int cols) : rows_(rows), cols_(cols) {}
 
     struct Scratch {
-        std::vector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
+        AlignedVector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
         // The running bounds of the motion of the rows this block's sweep updated, when asked for: 8 lanes of
         // lo and of hi per component (fast_solver.cpp).
         alignas(64) std::array<double, 48> motion_lanes{};
@@ -98,8 +98,8 @@ private:
     std::array<std::vector<std::pair<int, float>>, 6> fixes_;
     int blocks_ = 0;                           // the row-block count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
-    std::vector<float> boundary_;              // spring rows just above block boundaries
-    std::vector<float> zeros_;                 // a spring row of zeros: the rows above row 0
+    AlignedVector<float> boundary_;            // spring rows just above block boundaries
+    AlignedVector<float> zeros_;               // a spring row of zeros: the rows above row 0
     std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
     std::vector<int> no_boundary_;             // all -1: one block sweeping every row
     TeamChoice team_;                          // solver.threads = 0: the team, or one thread when it is faster

@@ -524,7 +524,7 @@ namespace {
 
 struct Grid {
     int rows, cols;
-    const std::array<std::vector<float>, 6>& rest;
+    const std::array<AlignedVector<float>, 6>& rest;
     const std::array<bool, 6>& present;
     const std::array<std::vector<float>, 6>& row_weight;
     const std::array<std::vector<int>, 6>& fix_begin;

@@ -88,7 +88,7 @@ private:
     void spring_row(const State& state, const SpringSettings& springs, unsigned mask, int r, float* out) const;
 
     int rows_, cols_;
-    std::array<std::vector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
+    std::array<AlignedVector<float>, 6> rest_;  // rest length of the spring leaving particle i in direction d
     std::array<bool, 6> present_{};            // the topology has springs in direction d (all of them, or none)
     bool bends_ = false;                       // directions 4 and 5 are bends, not skip-one springs
     std::array<std::vector<float>, 6> row_weight_;  // the largest weight of direction d's elements in row r

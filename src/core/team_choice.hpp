@@ -3,10 +3,10 @@
 // OpenMP's barrier spins for a while, then sleeps. When another process holds one of the team's cores, the
 // descheduled thread reaches the barrier a scheduler slice late, every substep, and the team is far slower
 // than one thread (docs/PERFORMANCE.md has the figures). With solver.threads = 0 the solver therefore keeps a
-// running estimate of a substep's time with the team and with one thread, now and then runs a few substeps
-// the other way (a probe, timed on its last substep), and uses whichever is faster. A probe that loses
-// doubles the wait before the next one (64 to 4096 substeps), so a team that stays slow costs little to keep
-// checking. Results are bit-identical for any thread count (fast_solver.hpp), so switching never changes the
+// running estimate of a substep's mean time with the team and with one thread over about the last frame, now
+// and then runs a few substeps the other way (a probe, timed on the fastest of its last two), and uses
+// whichever is faster. A probe that loses doubles the wait before the next one (64 to 4096 substeps), so a
+// team that stays slow costs little to keep checking. Results are bit-identical for any thread count (fast_solver.hpp), so switching never changes the
 // cloth.
 #pragma once
 
@@ -32,12 +32,28 @@ public:
     void record(bool single, std::chrono::steady_clock::duration elapsed) {
         const double us = std::chrono::duration<double, std::micro>(elapsed).count();
         const bool probing = probe_left_ > 0;
-        // A probe's first substeps move the data into the other cores' caches: only its last one counts.
-        if (probing && --probe_left_ > 0) return;
+        if (probing) {
+            // A probe's first substep moves the data into the other cores' caches and is not counted; of the
+            // others the fastest counts, so one preempted substep does not decide a probe.
+            if (probe_left_ < kProbeLength) probe_best_us_ = probe_best_us_ < 0.0 ? us : std::min(probe_best_us_, us);
+            if (--probe_left_ > 0) return;
+        }
         double& estimate = single ? single_us_ : team_us_;
-        // Exponential average of the choice in use; a probe replaces the other choice's estimate, which is
-        // as old as the last probe (the load it saw may be gone).
-        estimate = estimate < 0.0 || probing ? us : estimate + kWeight * (us - estimate);
+        if (probing) {
+            // A probe replaces the other choice's estimate, which is as old as the last probe (the load it saw
+            // may be gone).
+            estimate = probe_best_us_;
+            probe_best_us_ = -1.0;
+        } else if (estimate < 0.0) {
+            estimate = us;
+        } else {
+            // The mean substep of about the last kWindowUs of the choice in use (an exponential average, each
+            // substep weighted by its share of the window): what a frame pays. A shared machine's occasional
+            // preempted substep (a scheduler slice, milliseconds) moves it by that substep's share of the window
+            // only, so it does not make a faster team look slower; a team slowed on average (a core taken by
+            // another process) still overtakes one thread within about a window.
+            estimate += std::min(kMaxWeight, estimate / kWindowUs) * (us - estimate);
+        }
         if (single_us_ < 0.0 || team_us_ < 0.0) return;
         const bool was = single_;
         single_ = single_us_ < team_us_;
@@ -47,12 +63,14 @@ public:
     void reset() { *this = TeamChoice{}; }
 
 private:
-    static constexpr double kWeight = 0.25;
+    static constexpr double kWindowUs = 16000.0;  // about a frame
+    static constexpr double kMaxWeight = 0.25;
     bool single_ = false;
     int probe_left_ = 0;
     int since_probe_ = 0;
     int wait_ = kFirstProbe;
     double single_us_ = -1.0, team_us_ = -1.0;
+    double probe_best_us_ = -1.0;  // the fastest counted substep of the probe under way
 };
 
 }  // namespace clothsim

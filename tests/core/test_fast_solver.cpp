@@ -263,6 +263,40 @@ TEST_CASE("team choice: uses the faster of team and one thread, probing the othe
     CHECK_FALSE(choice.single());
 }
 
+TEST_CASE("team choice: a preempted substep now and then does not give up a faster team, a team slow on average "
+          "is given up") {
+    using std::chrono::microseconds;
+    TeamChoice choice;
+    // Runs substeps whose cost the function of (substep, single) gives; returns how many ran one thread.
+    int substep = 0;
+    auto run = [&](int substeps, auto cost_us) {
+        int singles = 0;
+        for (int i = 0; i < substeps; ++i, ++substep) {
+            const bool single = choice.next_is_single();
+            singles += single;
+            choice.record(single, microseconds(cost_us(substep, single)));
+        }
+        return singles;
+    };
+    // 256 x 256 on this machine: the team 120 us a substep, one thread 240. Every 300th team substep is
+    // preempted for a scheduler slice (4 ms): the team's mean is 133 us, still the faster. Only the probes
+    // run one thread (a fixed weight of a quarter made the team lose for 64 substeps after each such one).
+    const int singles = run(20000, [](int i, bool single) { return single ? 240 : (i % 300 == 299 ? 4000 : 120); });
+    CHECK_FALSE(choice.single());
+    CHECK(singles <= 9 * TeamChoice::kProbeLength);
+    // A team preempted every 10th substep for 4 ms is slower on average (520 us) than one thread: given up.
+    run(2000, [](int i, bool single) { return single ? 240 : (i % 10 == 9 ? 4000 : 120); });
+    CHECK(choice.single());
+    // Free again, but the last substep of the probe that finds it is preempted: the faster of the two it
+    // counts decides, and the team is taken back.
+    int in_a_row = 0;  // team substeps in a row
+    run(9000, [&](int, bool single) {
+        in_a_row = single ? 0 : in_a_row + 1;
+        return single ? 240 : (in_a_row == TeamChoice::kProbeLength ? 4000 : 120);
+    });
+    CHECK_FALSE(choice.single());
+}
+
 TEST_CASE("fast solver sees particles moved between its substeps by collisions, limits, pins, tools and another "
           "integrator", "[fast_solver]") {
     // Every move made outside the fast solver's sweep must be what its next substep reads: the same actions

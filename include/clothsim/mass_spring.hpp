@@ -105,6 +105,8 @@ public:
     // runs position Verlet), and with how many threads the current settings step.
     bool fast_solver_available() const { return fast_.solver != nullptr; }
     int solver_threads() const;
+    // The collision broad phase's blocks and their boxes as the last substep left them (for tests).
+    const CollisionBlocks& collision_blocks() const { return blocks_; }
     // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
     // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth).
     bool last_step_fast() const;
@@ -200,6 +202,11 @@ private:
     bool collide(StepProfile* profile);
     // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
     bool collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted);
+    // Returns how many tethers were at their limit.
+    std::size_t apply_tethers();
+    // The collision blocks' boxes again after the stages that follow the solver moved particles; false when
+    // left to the collision stage.
+    bool box_blocks_on_team(StepProfile* profile);
     // Each returns whether it moved a particle.
     bool limit_strain();
     bool limit_speed(double h);

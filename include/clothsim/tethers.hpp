@@ -45,5 +45,11 @@ Tethers build_tethers(const Topology& topology, const State& state, const DVec3A
 // limit stops the particle stretching it, and like a collision push it adds no velocity of its own, so it
 // never adds energy. One pass in tether order; returns how many tethers were at their limit.
 std::size_t project_tethers(State& state, const Tethers& tethers, double strain);
+// The same for tethers [first, last) only. A tether moves only its own free particle, towards a pin that does
+// not move, so particles' tethers may be projected in any order of particles (on several threads) with the
+// same result, as long as each particle's run stays in order.
+std::size_t project_tethers(State& state, const Tethers& tethers, double strain, std::size_t first, std::size_t last);
+// The first tether of a particle at or after `particle` (tethers are grouped by particle in index order).
+std::size_t first_tether_from(const Tethers& tethers, std::uint32_t particle);
 
 }  // namespace clothsim

@@ -488,6 +488,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
         if (motion_bounds) *motion_bounds = reduce_lanes(scratch_[0].motion_lanes.data());
         state.substep = h;
+        last_blocks_ = 1;
         return;
     }
     const auto start = std::chrono::steady_clock::now();
@@ -512,10 +513,26 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         }
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
+    last_blocks_ = blocks;
     for (int b = 0; motion_bounds && b < blocks; ++b) {
         if (block_begin(b) < block_begin(b + 1)) motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
     }
     state.substep = h;
+}
+
+void FastSolver::for_each_block(const std::function<void(int, int, int)>& work) const {
+    const int blocks = last_blocks_;
+    if (blocks <= 1) {
+        work(0, 0, rows_);
+        return;
+    }
+    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
+#pragma omp parallel num_threads(blocks)
+    {
+        // As in step(): every thread takes every team-size-th block, so block b runs on the thread that swept it.
+        const int team = omp_get_num_threads();
+        for (int b = omp_get_thread_num(); b < blocks; b += team) work(b, block_begin(b), block_begin(b + 1));
+    }
 }
 
 // ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----

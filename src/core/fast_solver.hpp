@@ -30,6 +30,7 @@
 #include "team_choice.hpp"
 
 #include <array>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -57,6 +58,11 @@ public:
     int effective_threads(int requested) const;
     // With threads = 0: whether the last substeps ran on one thread because the team was slower.
     bool team_set_aside() const { return team_.single(); }
+    // Runs work(block, row_begin, row_end) over all rows, split as the last substep's sweep split them, each
+    // block on the thread that swept it (all rows on this thread when the last substep ran on one): a stage
+    // that touches each particle on its own (the tethers, the collision boxes) then finds each block in the
+    // caches of the core that has just written it. Blocks are numbered from 0, fewer than 64.
+    void for_each_block(const std::function<void(int, int, int)>& work) const;
     // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
     static FastKernel best_kernel();
     static FastKernel kernel();
@@ -103,6 +109,7 @@ private:
     std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
     std::vector<int> no_boundary_;             // all -1: one block sweeping every row
     TeamChoice team_;                          // solver.threads = 0: the team, or one thread when it is faster
+    int last_blocks_ = 1;                      // the row blocks of the last substep (1: it ran on one thread)
 };
 
 }  // namespace clothsim

@@ -203,7 +203,7 @@ void MassSpring::step() {
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
-            tethers_at_limit_ = project_tethers(state_, tethers_, settings_.springs.tether_strain);
+            tethers_at_limit_ = apply_tethers();
         }
         bool limited = false;
         if (plan_.strain_limit) {
@@ -214,7 +214,8 @@ void MassSpring::step() {
             StageTimer timer(profile, Stage::SpeedLimit);
             limited = limit_speed(h) || limited;
         }
-        blocks_.current = blocks_.boxes_current = false;
+        blocks_.current = false;
+        blocks_.boxes_current = box_blocks_on_team(profile);
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
         moved_uncounted_ = pushed || limited || (plan_.tethers && tethers_at_limit_ > 0);
     }
@@ -279,6 +280,44 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Integrate);
         integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
     }
+}
+
+// On the fast path the tethers run on the fast solver's threads, each on the row block it has just swept (its
+// particles are in that core's caches; a pass on one thread over the whole cloth made the second core's block
+// move to the first core and back every substep). Particles project independently (tethers.hpp), so the
+// result is the same on any number of threads.
+std::size_t MassSpring::apply_tethers() {
+    const double strain = settings_.springs.tether_strain;
+    if (plan_.path != StepPath::Fast || !fast_.solver) return project_tethers(state_, tethers_, strain);
+    std::array<std::size_t, 64> active{};
+    const auto cols = static_cast<std::uint32_t>(topology_.cols);
+    fast_.solver->for_each_block([&](int block, int begin, int end) {
+        const std::size_t first = first_tether_from(tethers_, static_cast<std::uint32_t>(begin) * cols);
+        const std::size_t last = first_tether_from(tethers_, static_cast<std::uint32_t>(end) * cols);
+        active[static_cast<std::size_t>(block)] = project_tethers(state_, tethers_, strain, first, last);
+    });
+    std::size_t total = 0;
+    for (std::size_t a : active) total += a;
+    return total;
+}
+
+// The same split for the boxes of the collision broad phase's blocks (block_starts' grid layout, row by
+// row), which the collision stage would otherwise make again block by block on one thread.
+bool MassSpring::box_blocks_on_team(StepProfile* profile) {
+    if (plan_.path != StepPath::Fast || !fast_.solver || !plan_.any_collider() || !settings_.solver.broad_phase) {
+        return false;
+    }
+    StageTimer timer(profile, Stage::BroadPhase);
+    const int cols = topology_.cols;
+    const std::size_t per_row = blocks_per_row(cols);
+    blocks_.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
+    fast_.solver->for_each_block([&](int, int begin, int end) {
+        for (int r = begin; r < end; ++r) {
+            row_block_bounds(state_.position, static_cast<std::size_t>(r) * cols, static_cast<std::size_t>(cols),
+                             blocks_.boxes.data() + static_cast<std::size_t>(r) * per_row);
+        }
+    });
+    return true;
 }
 
 bool MassSpring::collide(StepProfile* profile) {

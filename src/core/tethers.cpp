@@ -72,8 +72,17 @@ Tethers build_tethers(const Topology& topology, const State& state, const DVec3A
 }
 
 std::size_t project_tethers(State& state, const Tethers& tethers, double strain) {
+    return project_tethers(state, tethers, strain, 0, tethers.size());
+}
+
+std::size_t first_tether_from(const Tethers& tethers, std::uint32_t particle) {
+    return static_cast<std::size_t>(std::lower_bound(tethers.particle.begin(), tethers.particle.end(), particle) -
+                                    tethers.particle.begin());
+}
+
+std::size_t project_tethers(State& state, const Tethers& tethers, double strain, std::size_t first, std::size_t last) {
     std::size_t active = 0;
-    for (std::size_t t = 0; t < tethers.size(); ++t) {
+    for (std::size_t t = first; t < std::min(last, tethers.size()); ++t) {
         const std::uint32_t i = tethers.particle[t];
         const glm::dvec3 anchor = state.position.get(tethers.anchor[t]);
         const glm::dvec3 d = state.position.get(i) - anchor;

@@ -1,6 +1,9 @@
 // Tethers (tethers.hpp): long-range attachments from each free particle to the pins it hangs from.
+#include "every_kernel.hpp"
 #include "support.hpp"
 
+#include "clothsim/broad_phase.hpp"
+#include "clothsim/colliders.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/strain.hpp"
 #include "clothsim/tethers.hpp"
@@ -105,6 +108,69 @@ TEST_CASE("tethers: a cloth hanging from two point pins never stretches past tet
     CHECK(tied_pins <= 0.01 + 1e-6);  // rest lengths are float: 1.01 L in double differs by ~1e-8
     CHECK(untied_pins > 0.02);  // the point pins' singular load, which the tethers take
     CHECK(tied.all_finite());
+}
+
+TEST_CASE("tethers: on the fast solver's row blocks and threads the cloth is the textbook solver's bit for bit, its "
+          "hem lying on the ground, every kernel and thread count", "[tethers][fast_solver]") {
+    // The fast path projects each row block's tethers and boxes its collision blocks again on the thread that
+    // swept the block (MassSpring::apply_tethers, box_blocks_on_team); the textbook path in one pass. A box
+    // that missed a particle the tethers moved would leave it in the ground.
+    test::with_every_kernel([] {
+        Scene s = hanging(40, 0.001f);  // a tenth of the particles at their tethers' limit
+        s.settings.colliders.ground.height = 1.0f;  // the hem (0.6 m when hanging straight) lies on it
+        s.settings.solver.method = SolverMethod::Textbook;
+        MassSpring textbook = build_simulation(s);
+        REQUIRE(textbook.plan().path == StepPath::Textbook);
+        textbook.run_steps(60);
+        for (int threads : {1, 2, 3}) {
+            s.settings.solver.threads = threads;
+            s.settings.solver.method = SolverMethod::Fast;
+            MassSpring fast = build_simulation(s);
+            REQUIRE(fast.plan().path == StepPath::Fast);
+            REQUIRE(fast.plan().tethers);
+            fast.run_steps(60);
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            CHECK(fast.tethers_at_limit() == textbook.tethers_at_limit());
+            CHECK(fast.tethers_at_limit() > 0);
+            CHECK(test::bit_identical(fast, textbook));
+        }
+        double lowest = INFINITY;
+        for (std::size_t i = 0; i < textbook.particle_count(); ++i) {
+            lowest = std::min(lowest, textbook.state().position.y[i]);
+        }
+        CHECK(lowest < 1.0 + 0.01);  // the hem does reach the ground
+    });
+}
+
+TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep bound the particles the tethers "
+          "moved, every kernel and thread count", "[tethers][fast_solver][broad_phase]") {
+    // The ground far below: the broad phase runs and no contact grows a box, so each box is exactly its
+    // block's bounds after the tethers (the sweep's boxes, made before them, are not). Tethers at 0.1% keep
+    // a tenth of the cloth's particles at their limit, block extremes among them.
+    test::with_every_kernel([] {
+        for (int threads : {1, 2, 3}) {
+            Scene s = hanging(40, 0.001f);
+            s.settings.colliders.ground.height = -10.0f;
+            s.settings.solver.threads = threads;
+            MassSpring fast = build_simulation(s);
+            REQUIRE(fast.plan().path == StepPath::Fast);
+            fast.run_steps(45);  // released flat, it reaches the tethers' limit as it swings down
+            int mismatched = 0, limited_substeps = 0;
+            for (int substep = 0; substep < 300; ++substep) {
+                fast.step();
+                limited_substeps += fast.tethers_at_limit() > 0;
+                const CollisionBlocks& blocks = fast.collision_blocks();
+                REQUIRE(blocks.boxes_current);
+                for (std::size_t k = 0; k < blocks.count(); ++k) {
+                    const Box want = particle_bounds(fast.state().position, blocks.start[k], blocks.start[k + 1]);
+                    mismatched += !(blocks.boxes[k].lo == want.lo && blocks.boxes[k].hi == want.hi);
+                }
+            }
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            CHECK(limited_substeps > 100);  // the tethers do move particles
+            CHECK(mismatched == 0);
+        }
+    });
 }
 
 TEST_CASE("tethers: slack tethers change nothing", "[tethers]") {

@@ -84,14 +84,14 @@ __attribute__((target("avx2"))) void row_bounds_avx2(const DVec3Array& position,
 #define CLOTHSIM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
 // maskz with all lanes throughout: the unmasked forms trip GCC 12's -Wuninitialized in its header.
 template <bool Max>
-CLOTHSIM_AVX512 [[gnu::always_inline]] inline __m512d bound(__m512d a, __m512d b) {
+[[gnu::always_inline]] CLOTHSIM_AVX512 inline __m512d bound(__m512d a, __m512d b) {
     return Max ? _mm512_maskz_max_pd(0xFF, a, b) : _mm512_maskz_min_pd(0xFF, a, b);
 }
 // Eight blocks' bounds of one axis folded together: v[j] holds block j's bounds lane by lane (no NaN), and
 // three rounds of shuffles and minima (maxima) leave block k in lane 2k and block k + 4 in lane 2k + 1
 // (the transpose-and-reduce of eight vectors: 21 instructions, where one vector's own reduction takes 6).
 template <bool Max>
-CLOTHSIM_AVX512 [[gnu::always_inline]] inline __m512d fold8(const __m512d v[8]) {
+[[gnu::always_inline]] CLOTHSIM_AVX512 inline __m512d fold8(const __m512d v[8]) {
     __m512d s[4], u[2];
     for (int p = 0; p < 4; ++p) {  // 128-bit chunks 0-1: block 2p's halves folded; chunks 2-3: block 2p + 1's
         s[p] = bound<Max>(_mm512_maskz_shuffle_f64x2(0xFF, v[2 * p], v[2 * p + 1], _MM_SHUFFLE(1, 0, 1, 0)),

@@ -19,6 +19,7 @@ class TeamChoice {
 public:
     static constexpr int kFirstProbe = 64, kLongestWait = 4096;  // substeps between probes
     static constexpr int kProbeLength = 3;                         // substeps a probe runs the other way
+    static_assert(kProbeLength >= 2, "a probe counts its substeps after the first");
 
     // Whether the next substep should run on one thread.
     bool next_is_single() {
@@ -31,6 +32,10 @@ public:
     // Records how long a substep took with one thread (`single`) or the team, and chooses again.
     void record(bool single, std::chrono::steady_clock::duration elapsed) {
         const double us = std::chrono::duration<double, std::micro>(elapsed).count();
+        if (!started_) {  // the first substep starts the team's threads: no measure of either choice
+            started_ = true;
+            return;
+        }
         const bool probing = probe_left_ > 0;
         if (probing) {
             // A probe's first substep moves the data into the other cores' caches and is not counted; of the
@@ -57,7 +62,10 @@ public:
         if (single_us_ < 0.0 || team_us_ < 0.0) return;
         const bool was = single_;
         single_ = single_us_ < team_us_;
-        if (probing) wait_ = single_ != was ? kFirstProbe : std::min(2 * wait_, kLongestWait);
+        // The wait before the next probe doubles when a probe loses, and when the choice a probe won turns out
+        // slower over its window after all (a team preempted now and then wins short probes and loses on
+        // average): either way the other choice was not worth trying so soon.
+        if (probing ? single_ == was : single_ != was) wait_ = std::min(2 * wait_, kLongestWait);
     }
     bool single() const { return single_; }
     void reset() { *this = TeamChoice{}; }
@@ -65,6 +73,7 @@ public:
 private:
     static constexpr double kWindowUs = 16000.0;  // about a frame
     static constexpr double kMaxWeight = 0.25;
+    bool started_ = false;
     bool single_ = false;
     int probe_left_ = 0;
     int since_probe_ = 0;

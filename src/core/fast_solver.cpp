@@ -469,7 +469,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         no_boundary_.assign(rows_, -1);
         boundary_.assign(static_cast<std::size_t>(2 * blocks) * row_floats, 0.0f);
         for (int b = 1; b < blocks; ++b) {
-            const int begin = static_cast<int>(static_cast<long long>(rows_) * b / blocks);
+            const int begin = block_begin(b, blocks);
             boundary_slot_[begin - 2] = 2 * b;
             boundary_slot_[begin - 1] = 2 * b + 1;
         }
@@ -492,7 +492,6 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         return;
     }
     const auto start = std::chrono::steady_clock::now();
-    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
 #pragma omp parallel num_threads(blocks)
     {
         // OpenMP may give fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, nesting): every thread
@@ -501,7 +500,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         // Phase 1: the two spring rows above the next block read that block's first rows, which its thread
         // will overwrite; compute them while every position is still the old one.
         for (int b = omp_get_thread_num(); b + 1 < blocks; b += team) {
-            const int next = block_begin(b + 1);
+            const int next = block_begin(b + 1, blocks);
             for (int r : {next - 2, next - 1}) {
                 spring_row(state, settings.springs, spring_mask, r,
                            boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
@@ -509,13 +508,16 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         }
 #pragma omp barrier
         for (int b = omp_get_thread_num(); b < blocks; b += team) {
-            sweep(state, sweep_settings, block_begin(b), block_begin(b + 1), scratch_[b], boundary_slot_);
+            sweep(state, sweep_settings, block_begin(b, blocks), block_begin(b + 1, blocks), scratch_[b],
+                  boundary_slot_);
         }
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     last_blocks_ = blocks;
     for (int b = 0; motion_bounds && b < blocks; ++b) {
-        if (block_begin(b) < block_begin(b + 1)) motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
+        if (block_begin(b, blocks) < block_begin(b + 1, blocks)) {
+            motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
+        }
     }
     state.substep = h;
 }
@@ -526,12 +528,13 @@ void FastSolver::for_each_block(const std::function<void(int, int, int)>& work) 
         work(0, 0, rows_);
         return;
     }
-    auto block_begin = [&](int b) { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); };
 #pragma omp parallel num_threads(blocks)
     {
         // As in step(): every thread takes every team-size-th block, so block b runs on the thread that swept it.
         const int team = omp_get_num_threads();
-        for (int b = omp_get_thread_num(); b < blocks; b += team) work(b, block_begin(b), block_begin(b + 1));
+        for (int b = omp_get_thread_num(); b < blocks; b += team) {
+            work(b, block_begin(b, blocks), block_begin(b + 1, blocks));
+        }
     }
 }
 

@@ -61,7 +61,7 @@ public:
     // Runs work(block, row_begin, row_end) over all rows, split as the last substep's sweep split them, each
     // block on the thread that swept it (all rows on this thread when the last substep ran on one): a stage
     // that touches each particle on its own (the tethers, the collision boxes) then finds each block in the
-    // caches of the core that has just written it. Blocks are numbered from 0, fewer than 64.
+    // caches of the core that has just written it. Blocks are numbered from 0, at most 64 of them.
     void for_each_block(const std::function<void(int, int, int)>& work) const;
     // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
     static FastKernel best_kernel();
@@ -88,6 +88,8 @@ private:
         Box* row_boxes;
         bool motion_bounds;
     };
+    // The first row of block b of `blocks`: rows are split as evenly as whole rows allow.
+    int block_begin(int b, int blocks) const { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); }
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);
     // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).

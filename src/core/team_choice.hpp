@@ -6,8 +6,8 @@
 // running estimate of a substep's mean time with the team and with one thread over about the last frame, now
 // and then runs a few substeps the other way (a probe, timed on the fastest of its last two), and uses
 // whichever is faster. A probe that loses doubles the wait before the next one (64 to 4096 substeps), so a
-// team that stays slow costs little to keep checking. Results are bit-identical for any thread count (fast_solver.hpp), so switching never changes the
-// cloth.
+// team that stays slow costs little to keep checking. Results are bit-identical for any thread count
+// (fast_solver.hpp), so switching never changes the cloth.
 #pragma once
 
 #include <algorithm>

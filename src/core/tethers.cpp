@@ -82,7 +82,8 @@ std::size_t first_tether_from(const Tethers& tethers, std::uint32_t particle) {
 
 std::size_t project_tethers(State& state, const Tethers& tethers, double strain, std::size_t first, std::size_t last) {
     std::size_t active = 0;
-    for (std::size_t t = first; t < std::min(last, tethers.size()); ++t) {
+    last = std::min(last, tethers.size());
+    for (std::size_t t = first; t < last; ++t) {
         const std::uint32_t i = tethers.particle[t];
         const glm::dvec3 anchor = state.position.get(tethers.anchor[t]);
         const glm::dvec3 d = state.position.get(i) - anchor;

@@ -39,8 +39,18 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
 // The box around boxes[0, n) (empty for n = 0), as glm::min and glm::max fold them: a NaN bound is left out.
 Box union_of(const Box* boxes, std::size_t n);
 
-// The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles.
-void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out);
+// What the collision stage reads of a block's box. The ground (a half-space below a height) reads only the
+// box's lowest y (may_touch), so when it is the only collider each block needs only its lowest point: a
+// Lowest box is that bound with its other five sides open (+-infinity), still a conservative box, found with
+// one axis and one reduction instead of six.
+enum class BlockBounds { Box, Lowest };
+// The bounds the enabled colliders read: Lowest when the ground is the only one.
+BlockBounds block_bounds_for(const ColliderSettings& colliders);
+
+// The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles. With
+// BlockBounds::Lowest, each block's lowest point in an otherwise open box (empty when no y is a number).
+void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out,
+                      BlockBounds bounds = BlockBounds::Box);
 
 // Block k holds particles [start[k], start[k + 1]). For a rows x cols grid (rows * cols == particles) the
 // blocks are runs of at most kBlockParticles along each row, in row order: row r's j-th run is block

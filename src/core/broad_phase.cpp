@@ -80,6 +80,33 @@ __attribute__((target("avx2"))) void row_bounds_avx2(const DVec3Array& position,
     if (c < count) *out = particle_bounds(position, begin + c, begin + count);
 }
 
+// A block's lowest point: a box open on every other side, or the empty box when no y is a number (as
+// particle_bounds leaves a block of NaN particles).
+Box lowest_box(double lowest) {
+    if (!(lowest < INFINITY)) return Box{};
+    return Box{glm::vec3(-INFINITY, static_cast<float>(lowest), -INFINITY), glm::vec3(INFINITY)};
+}
+
+double lowest_generic(const double* y, std::size_t n) {
+    double lo = INFINITY;
+    for (std::size_t i = 0; i < n; ++i) lo = y[i] < lo ? y[i] : lo;  // NaN left out
+    return lo;
+}
+
+// A row's blocks' lowest points: four vectors of the y axis per full block, then a shuffle reduction.
+__attribute__((target("avx2"))) void row_lowest_avx2(const double* y, std::size_t count, Box* out) {
+    std::size_t c = 0;
+    for (; c + 16 <= count; c += 16, ++out) {
+        const __m256d inf = _mm256_set1_pd(INFINITY);  // _mm256_min_pd(x, lo) is lo when x is NaN
+        __m256d lo0 = _mm256_min_pd(_mm256_loadu_pd(y + c), inf);
+        __m256d lo1 = _mm256_min_pd(_mm256_loadu_pd(y + c + 4), inf);
+        lo0 = _mm256_min_pd(_mm256_loadu_pd(y + c + 8), lo0);
+        lo1 = _mm256_min_pd(_mm256_loadu_pd(y + c + 12), lo1);
+        *out = lowest_box(hmin(_mm256_min_pd(lo0, lo1)));  // no NaN left in either
+    }
+    if (c < count) *out = lowest_box(lowest_generic(y + c, count - c));
+}
+
 #define CLOTHSIM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
 // maskz with all lanes throughout: the unmasked forms trip GCC 12's -Wuninitialized in its header.
 template <bool Max>
@@ -216,8 +243,25 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
 
 // Chosen as the fast solver chooses its kernels (FastSolver::kernel), so the tests run each one this CPU has.
 // A minimum and a maximum round nothing: every kernel gives particle_bounds' boxes (up to the sign of a zero).
-void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out) {
+BlockBounds block_bounds_for(const ColliderSettings& colliders) {
+    const bool shapes = colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled;
+    return shapes ? BlockBounds::Box : BlockBounds::Lowest;
+}
+
+void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out, BlockBounds bounds) {
     static_assert(kBlockParticles == 16, "the row kernels bound 16 particles per block");
+    if (bounds == BlockBounds::Lowest) {
+        const double* y = position.y.data() + begin;
+        switch (FastSolver::kernel()) {
+            case FastKernel::Avx512:  // four loads and a reduction per block: 512-bit vectors would save two loads
+            case FastKernel::Avx2: row_lowest_avx2(y, count, out); return;
+            case FastKernel::Generic: break;
+        }
+        for (std::size_t c = 0; c < count; c += kBlockParticles, ++out) {
+            *out = lowest_box(lowest_generic(y + c, std::min(kBlockParticles, count - c)));
+        }
+        return;
+    }
     switch (FastSolver::kernel()) {
         case FastKernel::Avx512: row_bounds_avx512(position, begin, count, out); return;
         case FastKernel::Avx2: row_bounds_avx2(position, begin, count, out); return;

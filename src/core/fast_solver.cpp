@@ -774,6 +774,7 @@ struct SweepInput {
     const Vec3Array* external;
     double h;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
+    BlockBounds bounds;  // what of each box (block_bounds_for the colliders)
     float* window;
     const float* zeros;
     double* motion_lanes;  // the running bounds of the block's motion (8 lanes), or null when not asked for
@@ -822,7 +823,8 @@ template <FastKernel K, unsigned Mask>
         }
         // The row is still in L1: the boxes of its blocks for the collision broad phase cost one more pass.
         if (in.row_boxes) {
-            row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols));
+            row_block_bounds(state.position, i0, grid.cols, in.row_boxes + static_cast<std::size_t>(r) * blocks_per_row(grid.cols),
+                             in.bounds);
         }
     }
 }
@@ -893,7 +895,7 @@ void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int 
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
-                        sweep.row_boxes, scratch.window.data(), zeros_.data(),
+                        sweep.row_boxes, block_bounds_for(sweep.settings.colliders), scratch.window.data(), zeros_.data(),
                         sweep.motion_bounds ? scratch.motion_lanes.data() : nullptr};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);
 }

@@ -310,11 +310,12 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile) {
     StageTimer timer(profile, Stage::BroadPhase);
     const int cols = topology_.cols;
     const std::size_t per_row = blocks_per_row(cols);
+    const BlockBounds bounds = block_bounds_for(settings_.colliders);
     blocks_.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
     fast_.solver->for_each_block([&](int, int begin, int end) {
         for (int r = begin; r < end; ++r) {
             row_block_bounds(state_.position, static_cast<std::size_t>(r) * cols, static_cast<std::size_t>(cols),
-                             blocks_.boxes.data() + static_cast<std::size_t>(r) * per_row);
+                             blocks_.boxes.data() + static_cast<std::size_t>(r) * per_row, bounds);
         }
     });
     return true;

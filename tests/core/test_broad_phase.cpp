@@ -5,6 +5,7 @@
 
 #include "clothsim/broad_phase.hpp"
 #include "clothsim/colliders.hpp"
+#include "clothsim/scene.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -236,9 +237,73 @@ TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles 
                 CHECK(boxes[j].lo == want.lo);
                 CHECK(boxes[j].hi == want.hi);
             }
+            // Only the lowest points: the same lo.y, the other sides open; empty where the block has no y.
+            std::vector<Box> lowest(per_row);
+            row_block_bounds(p, begin, static_cast<std::size_t>(cols), lowest.data(), BlockBounds::Lowest);
+            for (std::size_t j = 0; j < lowest.size(); ++j) {
+                INFO(FastSolver::kernel_name(FastSolver::kernel()) << ": lowest, row " << r << ", block " << j);
+                const Box want = reference_bounds(p, starts[r * per_row + j], starts[r * per_row + j + 1]);
+                CHECK(lowest[j].empty() == !(want.lo.y < INFINITY));
+                if (lowest[j].empty()) continue;
+                CHECK(lowest[j].lo == glm::vec3(-INFINITY, want.lo.y, -INFINITY));
+                CHECK(lowest[j].hi == glm::vec3(INFINITY));
+            }
         }
     });
     CHECK(particle_bounds(p, row, row + kBlockParticles).empty());
+}
+
+TEST_CASE("broad_phase block_bounds_for asks for the lowest points only when the ground is the only collider",
+          "[broad_phase]") {
+    ColliderSettings c;
+    c.ground.enabled = true;
+    CHECK(block_bounds_for(c) == BlockBounds::Lowest);
+    c.sphere.enabled = true;
+    CHECK(block_bounds_for(c) == BlockBounds::Box);
+    c.sphere.enabled = false, c.cube.enabled = true;
+    CHECK(block_bounds_for(c) == BlockBounds::Box);
+    c.cube.enabled = false, c.cylinder.enabled = true;
+    CHECK(block_bounds_for(c) == BlockBounds::Box);
+    // The ground reads nothing of a box but its lowest y: an open box tests as the whole one.
+    const GroundCollider ground{true, 0.2f, 0.5f};
+    for (float y : {-1.0f, 0.19f, 0.2f, 0.2049f, 0.21f, 3.0f}) {
+        const Box whole{{0.3f, y, -0.4f}, {0.5f, y + 0.7f, 0.1f}};
+        const Box open{{-INFINITY, y, -INFINITY}, glm::vec3(INFINITY)};
+        CHECK(may_touch(ground, 0.005f, open) == may_touch(ground, 0.005f, whole));
+    }
+}
+
+TEST_CASE("broad_phase a cloth hanging onto the ground moves the same with lowest points only as with whole boxes",
+          "[broad_phase][fast_solver]") {
+    // `hanging` with the ground raised into its reach: the hem lands and the ground pushes particles. With the
+    // ground alone the fast solver's boxes hold the lowest points only; a sphere far out of reach makes them
+    // whole boxes and changes nothing else, so both runs must be bit-identical, every kernel and thread count.
+    test::with_every_kernel([] {
+        for (int threads : {1, 2}) {
+            Scene s = load_scene("hanging");
+            apply_override(s, "cloth.rows=24");
+            apply_override(s, "cloth.cols=24");
+            s.settings.colliders.ground.height = 1.0f;
+            s.settings.solver.threads = threads;
+            Scene with_sphere = s;
+            with_sphere.settings.colliders.sphere = SphereCollider{true, {0.0f, 30.0f, 0.0f}, 1.0f, 0.3f};
+            REQUIRE(block_bounds_for(s.settings.colliders) == BlockBounds::Lowest);
+            MassSpring lowest = build_simulation(s), whole = build_simulation(with_sphere);
+            REQUIRE(lowest.plan().path == StepPath::Fast);
+            lowest.set_profiling(true);
+            lowest.run_steps(60);
+            whole.run_steps(60);
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            CHECK(test::bit_identical(lowest, whole));
+            double low = INFINITY;
+            for (double y : lowest.state().position.y) low = std::min(low, y);
+            CHECK(low < 1.0 + 2.0 * s.settings.colliders.thickness);  // on the ground
+            const StepProfile& profile = lowest.profile();
+            const int ground = collider_index(Stage::Ground);
+            CHECK(profile.blocks_tested[ground] > 0);
+            CHECK(profile.blocks_tested[ground] < profile.blocks_offered[ground]);  // the rest are culled
+        }
+    });
 }
 
 TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the collider's centre",

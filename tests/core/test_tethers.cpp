@@ -146,29 +146,40 @@ TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep
           "moved, every kernel and thread count", "[tethers][fast_solver][broad_phase]") {
     // The ground far below: the broad phase runs and no contact grows a box, so each box is exactly its
     // block's bounds after the tethers (the sweep's boxes, made before them, are not). Tethers at 0.1% keep
-    // a tenth of the cloth's particles at their limit, block extremes among them.
+    // a tenth of the cloth's particles at their limit, block extremes among them. With the ground alone the
+    // boxes hold each block's lowest point only (BlockBounds::Lowest); a sphere out of reach makes them whole
+    // boxes, swept by the cloth's largest motion.
     test::with_every_kernel([] {
-        for (int threads : {1, 2, 3}) {
-            Scene s = hanging(40, 0.001f);
-            s.settings.colliders.ground.height = -10.0f;
-            s.settings.solver.threads = threads;
-            MassSpring fast = build_simulation(s);
-            REQUIRE(fast.plan().path == StepPath::Fast);
-            fast.run_steps(45);  // released flat, it reaches the tethers' limit as it swings down
-            int mismatched = 0, limited_substeps = 0;
-            for (int substep = 0; substep < 300; ++substep) {
-                fast.step();
-                limited_substeps += fast.tethers_at_limit() > 0;
-                const CollisionBlocks& blocks = fast.collision_blocks();
-                REQUIRE(blocks.boxes_current);
-                for (std::size_t k = 0; k < blocks.count(); ++k) {
-                    const Box want = particle_bounds(fast.state().position, blocks.start[k], blocks.start[k + 1]);
-                    mismatched += !(blocks.boxes[k].lo == want.lo && blocks.boxes[k].hi == want.hi);
+        for (bool sphere : {false, true}) {
+            for (int threads : {1, 2, 3}) {
+                Scene s = hanging(40, 0.001f);
+                s.settings.colliders.ground.height = -10.0f;
+                s.settings.colliders.sphere = SphereCollider{sphere, {0.0f, 20.0f, 0.0f}, 1.0f, 0.3f};
+                s.settings.solver.threads = threads;
+                MassSpring fast = build_simulation(s);
+                REQUIRE(fast.plan().path == StepPath::Fast);
+                REQUIRE(block_bounds_for(s.settings.colliders) == (sphere ? BlockBounds::Box : BlockBounds::Lowest));
+                fast.run_steps(45);  // released flat, it reaches the tethers' limit as it swings down
+                int mismatched = 0, limited_substeps = 0;
+                for (int substep = 0; substep < 300; ++substep) {
+                    fast.step();
+                    limited_substeps += fast.tethers_at_limit() > 0;
+                    const CollisionBlocks& blocks = fast.collision_blocks();
+                    REQUIRE(blocks.boxes_current);
+                    // With the sphere the stage sweeps each box by the cloth's largest motion (colliders.cpp).
+                    const Box motion = particle_bounds(fast.state().motion, 0, fast.state().size());
+                    const glm::vec3 reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
+                    for (std::size_t k = 0; k < blocks.count(); ++k) {
+                        Box want = particle_bounds(fast.state().position, blocks.start[k], blocks.start[k + 1]);
+                        if (sphere) want = Box{want.lo - reach, want.hi + reach};
+                        if (!sphere) want = Box{glm::vec3(-INFINITY, want.lo.y, -INFINITY), glm::vec3(INFINITY)};
+                        mismatched += !(blocks.boxes[k].lo == want.lo && blocks.boxes[k].hi == want.hi);
+                    }
                 }
+                INFO(FastSolver::kernel_name() << ", " << threads << " thread(s), sphere " << sphere);
+                CHECK(limited_substeps > 100);  // the tethers do move particles
+                CHECK(mismatched == 0);
             }
-            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
-            CHECK(limited_substeps > 100);  // the tethers do move particles
-            CHECK(mismatched == 0);
         }
     });
 }

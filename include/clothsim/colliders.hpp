@@ -70,9 +70,10 @@ struct CollisionBlocks {
 // Each collider's time and block counts go to `profile` when it is not null. `threads` share the blocks a
 // collider tests when they hold kParallelCollisionParticles particles or more (four times as many for the
 // ground; the same result for any count). Returns false when no particle was tested against any collider, so
-// none moved.
+// none moved. `motion`, when not null, bounds every particle's motion as it is now (the fast solver's sweep
+// takes them while it writes the motions): the swept boxes' reach then costs no pass over the motions.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile, int threads = 1);
+                   StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr);
 
 }  // namespace clothsim

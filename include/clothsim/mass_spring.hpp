@@ -198,8 +198,12 @@ private:
     void step_textbook(double h, StepProfile* profile);
     // `continues`: the state is what the previous substep left (a multistep integrator may use its history).
     void step_velocity_integrator(Integrator integrator, double h, bool continues);
-    // Returns false when it moved no particle.
-    bool collide(StepProfile* profile);
+    // Returns false when it moved no particle. `motion`: the bounds of every particle's motion as it is now, or
+    // null (collide_stage).
+    bool collide(StepProfile* profile, const MotionBounds* motion = nullptr);
+    // Whether the fast solver's sweep takes the bounds of the motion it writes: for self-collision, and for the
+    // swept boxes of the sphere, the cube and the cylinder (collide_stage).
+    bool sweep_takes_motion_bounds() const;
     // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
     bool collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted);
     // Returns how many tethers were at their limit.
@@ -261,7 +265,7 @@ private:
     StepProfile profile_;
     bool profiling_ = true;
     CollisionBlocks blocks_;     // particle blocks and their boxes for the collision broad phase
-    MotionBounds motion_bounds_; // the fast solver's bounds of this substep's motion, for self-collision
+    MotionBounds motion_bounds_; // the fast solver's bounds of this substep's motion (sweep_takes_motion_bounds)
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas

@@ -300,7 +300,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile, int threads) {
+                   StepProfile* profile, int threads, const MotionBounds* motion) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
         blocks.start = block_starts(state.size(), 0, 0);
         blocks.current = blocks.boxes_current = false;
@@ -320,10 +320,15 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         // (x - motion), so a particle that passed through the sphere, the cube or the cylinder in one substep is still
         // offered to it (continuous collision). One bound for the cloth costs one vectorised pass, not one
         // per block; the ground (a half-space: nothing passes through it unseen) needs none.
+        // The caller's bounds, rounded to float as particle_bounds rounds them, give the same reach; bounds
+        // that are not finite (a NaN motion, which the pass leaves out) are taken again by the pass.
         glm::vec3 reach(0.0f);
         if (colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled) {
-            const Box motion = particle_bounds(state.motion, 0, state.size());
-            if (!motion.empty()) reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
+            const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+            const bool known = motion && !motion->empty && finite(motion->lo) && finite(motion->hi);
+            const Box bounds = known ? Box{glm::vec3(motion->lo), glm::vec3(motion->hi)}
+                                     : particle_bounds(state.motion, 0, state.size());
+            if (!bounds.empty()) reach = glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi));
         }
         if (!from_sweep || reach != glm::vec3(0.0f)) {
             for (std::size_t k = 0; k < count; ++k) {

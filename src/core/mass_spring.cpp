@@ -189,10 +189,11 @@ void MassSpring::step() {
             step_velocity_integrator(integrator, h, continues);
         } break;
     }
-    const bool collided = collide(profile);
-    // With self-collision on, the fast solver's sweep takes the bounds of the motion it writes; they hold while
-    // no collider moved a particle.
-    const MotionBounds* known = plan_.path == StepPath::Fast && !collided ? &motion_bounds_ : nullptr;
+    // The fast solver's sweep may have taken the bounds of the motion it wrote; they hold until a stage moves a
+    // particle.
+    const bool swept_bounds = plan_.path == StepPath::Fast && sweep_takes_motion_bounds();
+    const bool collided = collide(profile, swept_bounds ? &motion_bounds_ : nullptr);
+    const MotionBounds* known = swept_bounds && !collided ? &motion_bounds_ : nullptr;
     // Moves outside the motions, which self-collision's budget does not count: a collider's push now, what
     // the stages after the last substep's self stage did, and the steps of RK4 and projective, whose motion
     // (v h at the substep's end) is not the substep's displacement.
@@ -262,7 +263,7 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     {
         StageTimer timer(profile, Stage::Fast);
         fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr,
-                           plan_.self_collision ? &motion_bounds_ : nullptr);
+                           sweep_takes_motion_bounds() ? &motion_bounds_ : nullptr);
     }
     blocks_.boxes_current = boxes;
     blocks_.current = false;  // the cloth's box is the union, made by the collision stage
@@ -321,9 +322,15 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile) {
     return true;
 }
 
-bool MassSpring::collide(StepProfile* profile) {
+bool MassSpring::sweep_takes_motion_bounds() const {
+    const bool swept_boxes = settings_.solver.broad_phase && (plan_.sphere || plan_.cube || plan_.cylinder);
+    return plan_.self_collision || swept_boxes;
+}
+
+bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
     if (!plan_.any_collider()) return false;
-    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads());
+    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads(),
+                         motion);
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.

@@ -306,6 +306,80 @@ TEST_CASE("broad_phase a cloth hanging onto the ground moves the same with lowes
     });
 }
 
+TEST_CASE("broad_phase the swept boxes' reach from the fast solver's bounds of the motion is the pass's reach",
+          "[broad_phase][fast_solver]") {
+    // A sphere far out of reach: the stage sweeps every block's box by the cloth's largest motion, which it now
+    // takes from the bounds the sweep took while writing the motions. Each box must be exactly its block's
+    // bounds grown by the reach a pass over the motions gives, every kernel and thread count.
+    test::with_every_kernel([] {
+        for (int threads : {1, 2, 3}) {
+            Scene s = load_scene("hanging");
+            apply_override(s, "cloth.rows=40");
+            apply_override(s, "cloth.cols=40");
+            s.settings.springs.tether_strain = 0.0f;  // no stage between the sweep and the collisions
+            s.settings.colliders.sphere = SphereCollider{true, {0.0f, 20.0f, 0.0f}, 1.0f, 0.3f};
+            s.settings.solver.threads = threads;
+            MassSpring fast = build_simulation(s);
+            REQUIRE(fast.plan().path == StepPath::Fast);
+            int mismatched = 0, boxes = 0;
+            for (int substep = 0; substep < 200; ++substep) {
+                fast.step();
+                const CollisionBlocks& blocks = fast.collision_blocks();
+                REQUIRE(blocks.boxes_current);
+                const Box motion = particle_bounds(fast.state().motion, 0, fast.state().size());
+                const glm::vec3 reach = glm::max(glm::abs(motion.lo), glm::abs(motion.hi));
+                for (std::size_t k = 0; k < blocks.count(); ++k, ++boxes) {
+                    const Box tight = particle_bounds(fast.state().position, blocks.start[k], blocks.start[k + 1]);
+                    mismatched += !(blocks.boxes[k].lo == tight.lo - reach && blocks.boxes[k].hi == tight.hi + reach);
+                }
+            }
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            CHECK(boxes == 200 * 120);
+            CHECK(mismatched == 0);
+        }
+    });
+}
+
+TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of the motion, from a pass when they "
+          "are not finite", "[broad_phase]") {
+    ColliderSettings colliders;
+    colliders.sphere = {true, {0.0f, 5.0f, 0.0f}, 0.3f, 0.4f};  // out of reach
+    std::mt19937 rng(8);
+    State st;
+    st.position.resize(100);
+    st.motion.resize(100);
+    st.mass.assign(100, 1.0f);
+    st.inverse_mass.assign(100, 1.0f);
+    st.pinned.assign(100, 0);
+    for (std::size_t i = 0; i < 100; ++i) {
+        st.position.set(i, random_vec(rng, 1.0f));
+        st.motion.set(i, 0.01f * random_vec(rng, 1.0f));
+    }
+    const auto boxes_with = [&](const MotionBounds* motion) {
+        CollisionBlocks blocks;
+        State copy = st;
+        collide_stage(copy, colliders, true, blocks, nullptr, 1, motion);
+        return blocks.boxes;
+    };
+    const auto same = [](const std::vector<Box>& a, const std::vector<Box>& b) {
+        bool equal = a.size() == b.size();
+        for (std::size_t k = 0; equal && k < a.size(); ++k) equal = a[k].lo == b[k].lo && a[k].hi == b[k].hi;
+        return equal;
+    };
+    const std::vector<Box> pass = boxes_with(nullptr);
+    MotionBounds exact;
+    include_motion(st.motion, 0, st.size(), exact);
+    CHECK(same(boxes_with(&exact), pass));
+    MotionBounds nan = exact;
+    nan.lo.y = NAN;  // a NaN motion in the sweep's lanes
+    CHECK(same(boxes_with(&nan), pass));
+    MotionBounds larger = exact;  // the bounds are used when finite: a larger reach grows every box further
+    larger.hi.x += 1.0;
+    const std::vector<Box> grown = boxes_with(&larger);
+    REQUIRE(grown.size() == pass.size());
+    CHECK(grown[0].hi.x > pass[0].hi.x);
+}
+
 TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the collider's centre",
           "[broad_phase]") {
     const SphereCollider sphere{true, {0.0f, 0.5f, 0.0f}, 0.3f, 0.3f};

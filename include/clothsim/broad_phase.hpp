@@ -40,12 +40,10 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
 Box union_of(const Box* boxes, std::size_t n);
 
 // What the collision stage reads of a block's box. The ground (a half-space below a height) reads only the
-// box's lowest y (may_touch), so when it is the only collider each block needs only its lowest point: a
-// Lowest box is that bound with its other five sides open (+-infinity), still a conservative box, found with
-// one axis and one reduction instead of six.
+// box's lowest y (may_touch), so when no other collider can reach the cloth each block needs only its lowest
+// point: a Lowest box is that bound with its other five sides open (+-infinity), still a conservative box,
+// found with one axis and one reduction instead of six (colliders.hpp: block_bounds_for chooses).
 enum class BlockBounds { Box, Lowest };
-// The bounds the enabled colliders read: Lowest when the ground is the only one.
-BlockBounds block_bounds_for(const ColliderSettings& colliders);
 
 // The boxes of the blocks of `count` particles from `begin` (one grid row): runs of kBlockParticles. With
 // BlockBounds::Lowest, each block's lowest point in an otherwise open box (empty when no y is a number).

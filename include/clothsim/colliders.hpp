@@ -50,12 +50,23 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
                  std::size_t end = kAllParticles);
 
 // The particles as blocks (broad_phase.hpp: block_starts), each block's box and the whole cloth's box.
+//
+// The carried box holds every particle from substep to substep without a pass over them: a substep's sweep
+// moves each particle by its motion, so the box grown by the motion's bounds (and by zero: it keeps where the
+// particles started) holds them after it, and their paths. Tethers keep it (each moves a particle toward its
+// pin, within the box); any other move (a collider's push, a limit, self-collision, an edit) makes it
+// invalid until the next whole boxes. While it lies out of reach of the sphere, the cube and the cylinder,
+// the blocks need only their lowest points (for the ground) and those colliders cost one test each.
 struct CollisionBlocks {
     std::vector<std::size_t> start;  // block k is particles [start[k], start[k + 1])
     std::vector<Box> boxes;          // one per block
+    BlockBounds bounds = BlockBounds::Box;  // what `boxes` hold
     Box cloth;                       // contains every block's box
     bool boxes_current = false;      // the block boxes bound the particles as they are now (the fast solver's)
     bool current = false;            // ... and `cloth` bounds them
+    glm::dvec3 carried_lo{0.0}, carried_hi{0.0};  // the carried box (above), in double: it grows every substep
+    bool carried_valid = false;
+    Box carried() const { return Box{glm::vec3(carried_lo), glm::vec3(carried_hi)}; }
     // Scratch of collide_stage: the blocks a collider tests, and which of them its pushes grew.
     std::vector<std::uint32_t> tested;
     std::vector<std::uint8_t> grown;
@@ -72,8 +83,17 @@ struct CollisionBlocks {
 // ground; the same result for any count). Returns false when no particle was tested against any collider, so
 // none moved. `motion`, when not null, bounds every particle's motion as it is now (the fast solver's sweep
 // takes them while it writes the motions): the swept boxes' reach then costs no pass over the motions.
+//
+// With Lowest boxes from the caller and the sphere, the cube or the cylinder enabled, those test the carried
+// box, grown here by `motion` (null: the particles moved since only in ways that keep it); when it may reach
+// one of them, or cannot be grown (a NaN motion), the stage makes whole boxes itself.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr);
+
+// What the fast solver's sweep should compute of each block for the next substep's collision stage: Lowest
+// when the ground is the only collider, or when the carried box is valid and out of reach of the sphere, the
+// cube and the cylinder; whole boxes otherwise.
+BlockBounds block_bounds_for(const ColliderSettings& colliders, const CollisionBlocks& blocks);
 
 }  // namespace clothsim

@@ -243,11 +243,6 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
 
 // Chosen as the fast solver chooses its kernels (FastSolver::kernel), so the tests run each one this CPU has.
 // A minimum and a maximum round nothing: every kernel gives particle_bounds' boxes (up to the sign of a zero).
-BlockBounds block_bounds_for(const ColliderSettings& colliders) {
-    const bool shapes = colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled;
-    return shapes ? BlockBounds::Box : BlockBounds::Lowest;
-}
-
 void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t count, Box* out, BlockBounds bounds) {
     static_assert(kBlockParticles == 16, "the row kernels bound 16 particles per block");
     if (bounds == BlockBounds::Lowest) {

@@ -218,9 +218,10 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
 // Returns the number of blocks tested: none, and no particle moved.
 template <class Shape>
 long long collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
-                         int which, int threads, StepProfile* profile) {
-    // First the whole cloth: a collider out of its reach costs this one test; then each block's box.
-    const bool whole_cloth = !broad_phase || may_touch(shape, thickness, blocks.cloth);
+                         const Box& cloth, int which, int threads, StepProfile* profile) {
+    // First the whole cloth (`cloth` holds it): a collider out of its reach costs this one test; then each
+    // block's box.
+    const bool whole_cloth = !broad_phase || may_touch(shape, thickness, cloth);
     blocks.tested.clear();
     std::size_t particles = 0;
     for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
@@ -299,6 +300,24 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
     if (colliders.cylinder.enabled) collide_shape(state, colliders.cylinder, T(colliders.cylinder.friction), thickness, begin, end);
     if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
 }
+// Whether the sphere, the cube or the cylinder (those enabled) may touch a particle in `box`.
+bool shapes_may_touch(const ColliderSettings& colliders, const Box& box) {
+    const float t = colliders.thickness;
+    return (colliders.sphere.enabled && may_touch(colliders.sphere, t, box)) ||
+           (colliders.cube.enabled && may_touch(colliders.cube, t, box)) ||
+           (colliders.cylinder.enabled && may_touch(colliders.cylinder, t, box));
+}
+
+bool any_shape(const ColliderSettings& colliders) {
+    return colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled;
+}
+
+BlockBounds block_bounds_for(const ColliderSettings& colliders, const CollisionBlocks& blocks) {
+    if (!any_shape(colliders)) return BlockBounds::Lowest;
+    return blocks.carried_valid && !shapes_may_touch(colliders, blocks.carried()) ? BlockBounds::Lowest
+                                                                                   : BlockBounds::Box;
+}
+
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile, int threads, const MotionBounds* motion) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
@@ -306,15 +325,32 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.current = blocks.boxes_current = false;
     }
     const std::size_t count = blocks.count();
-    const bool any =
-        colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled || colliders.ground.enabled;
-    if (!any) return false;
+    const bool shapes = any_shape(colliders);
+    if (!shapes && !colliders.ground.enabled) return false;
+    const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    const bool known = motion && !motion->empty && finite(motion->lo) && finite(motion->hi);
     if (!broad_phase) {
         blocks.boxes.resize(count);  // only counted: every block is tested
-        blocks.current = blocks.boxes_current = false;
+        blocks.current = blocks.boxes_current = blocks.carried_valid = false;
     } else if (!(blocks.current && blocks.boxes.size() == count)) {
         StageTimer timer(profile, Stage::BroadPhase);
-        const bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
+        bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
+        if (!from_sweep) blocks.bounds = BlockBounds::Box;
+        if (blocks.bounds == BlockBounds::Lowest && shapes) {
+            // Lowest points only: the sphere, the cube and the cylinder test the carried box, grown by this
+            // substep's motion; whole boxes are made here when it may reach one of them or cannot be grown.
+            if (motion) {
+                blocks.carried_valid = blocks.carried_valid && known;
+                if (blocks.carried_valid) {
+                    blocks.carried_lo += glm::min(motion->lo, glm::dvec3(0.0));
+                    blocks.carried_hi += glm::max(motion->hi, glm::dvec3(0.0));
+                }
+            }
+            if (!blocks.carried_valid || shapes_may_touch(colliders, blocks.carried())) {
+                from_sweep = false;
+                blocks.bounds = BlockBounds::Box;
+            }
+        }
         blocks.boxes.resize(count);
         // Swept boxes: grown by the cloth's largest motion per axis, they also hold where the substep started
         // (x - motion), so a particle that passed through the sphere, the cube or the cylinder in one substep is still
@@ -323,9 +359,7 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         // The caller's bounds, rounded to float as particle_bounds rounds them, give the same reach; bounds
         // that are not finite (a NaN motion, which the pass leaves out) are taken again by the pass.
         glm::vec3 reach(0.0f);
-        if (colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled) {
-            const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-            const bool known = motion && !motion->empty && finite(motion->lo) && finite(motion->hi);
+        if (shapes && blocks.bounds == BlockBounds::Box) {
             const Box bounds = known ? Box{glm::vec3(motion->lo), glm::vec3(motion->hi)}
                                      : particle_bounds(state.motion, 0, state.size());
             if (!bounds.empty()) reach = glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi));
@@ -343,21 +377,37 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     }
     const float thickness = colliders.thickness;
     long long tested = 0;
+    // With Lowest boxes the shapes meet only the carried box, which none of them can reach (checked above).
+    const Box shape_cloth = blocks.bounds == BlockBounds::Lowest ? blocks.carried() : blocks.cloth;
     if (colliders.sphere.enabled) {
         StageTimer timer(profile, Stage::Sphere);
-        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, collider_index(Stage::Sphere), threads, profile);
+        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, shape_cloth,
+                                 collider_index(Stage::Sphere), threads, profile);
     }
     if (colliders.cube.enabled) {
         StageTimer timer(profile, Stage::Cube);
-        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, collider_index(Stage::Cube), threads, profile);
+        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, shape_cloth,
+                                 collider_index(Stage::Cube), threads, profile);
     }
     if (colliders.cylinder.enabled) {
         StageTimer timer(profile, Stage::Cylinder);
-        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, collider_index(Stage::Cylinder), threads, profile);
+        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, shape_cloth,
+                                 collider_index(Stage::Cylinder), threads, profile);
     }
     if (colliders.ground.enabled) {
         StageTimer timer(profile, Stage::Ground);
-        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, collider_index(Stage::Ground), threads, profile);
+        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, blocks.cloth,
+                                 collider_index(Stage::Ground), threads, profile);
+    }
+    // Whole boxes (grown by any push) hold every particle: the carried box starts again from them. A push
+    // under Lowest boxes may leave the carried box.
+    if (broad_phase && blocks.bounds == BlockBounds::Box) {
+        blocks.carried_valid = !blocks.cloth.empty() && finite(glm::dvec3(blocks.cloth.lo)) &&
+                               finite(glm::dvec3(blocks.cloth.hi));
+        blocks.carried_lo = glm::dvec3(blocks.cloth.lo);
+        blocks.carried_hi = glm::dvec3(blocks.cloth.hi);
+    } else if (tested > 0) {
+        blocks.carried_valid = false;
     }
     return tested > 0;
 }

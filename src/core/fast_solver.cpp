@@ -455,7 +455,7 @@ int FastSolver::effective_threads(int requested) const {
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
-                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds) {
+                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
     const int blocks = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * spring_row_stride(cols_);
@@ -477,7 +477,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
     const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
-                                       motion_bounds != nullptr};
+                                       bounds, motion_bounds != nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
     const bool automatic = settings.solver.threads == 0 && blocks > 1;
     const bool single = blocks == 1 || (automatic && team_.next_is_single());
@@ -774,7 +774,7 @@ struct SweepInput {
     const Vec3Array* external;
     double h;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
-    BlockBounds bounds;  // what of each box (block_bounds_for the colliders)
+    BlockBounds bounds;  // what of each box
     float* window;
     const float* zeros;
     double* motion_lanes;  // the running bounds of the block's motion (8 lanes), or null when not asked for
@@ -895,7 +895,7 @@ void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int 
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
     const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
-                        sweep.row_boxes, block_bounds_for(sweep.settings.colliders), scratch.window.data(), zeros_.data(),
+                        sweep.row_boxes, sweep.bounds, scratch.window.data(), zeros_.data(),
                         sweep.motion_bounds ? scratch.motion_lanes.data() : nullptr};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);
 }

@@ -48,10 +48,12 @@ public:
     // One substep: the spring kinds in `spring_mask` (bit k: SpringKind k; step_plan.hpp) plus `external`
     // forces (N per particle, or null), and the Verlet update with gravity and damping. Collisions are the
     // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
-    // block_starts(rows x cols) after the update, and `motion_bounds` (when not null) the bounds of every
-    // particle's new motion, each row's taken in its update (for self-collision, self_collision.hpp).
+    // block_starts(rows x cols) after the update (only its lowest point with BlockBounds::Lowest), and
+    // `motion_bounds` (when not null) the bounds of every particle's new motion, each row's taken in its
+    // update (for self-collision, self_collision.hpp, and the colliders' swept boxes, colliders.hpp).
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
-              double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr);
+              double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
+              BlockBounds bounds = BlockBounds::Box);
 
     // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
     // at least 8.
@@ -86,6 +88,7 @@ private:
         const Vec3Array* external;
         double h;
         Box* row_boxes;
+        BlockBounds bounds;
         bool motion_bounds;
     };
     // The first row of block b of `blocks`: rows are split as evenly as whole rows allow.

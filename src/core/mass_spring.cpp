@@ -178,6 +178,7 @@ void MassSpring::step() {
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
     const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
+    if (!continues) blocks_.carried_valid = false;     // an edit may have moved particles out of it
     // Self-collision's list of near pairs holds while only steps move the particles (self_collision.hpp).
     if (!continues && self_collision_) self_collision_->invalidate();
 
@@ -215,6 +216,7 @@ void MassSpring::step() {
             StageTimer timer(profile, Stage::SpeedLimit);
             limited = limit_speed(h) || limited;
         }
+        if (self_moved || limited) blocks_.carried_valid = false;  // pushes and limits may leave it; tethers do not
         blocks_.current = false;
         blocks_.boxes_current = box_blocks_on_team(profile);
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
@@ -260,10 +262,11 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
         external = &grab_external_;
     }
     const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
+    if (boxes) blocks_.bounds = block_bounds_for(settings_.colliders, blocks_);
     {
         StageTimer timer(profile, Stage::Fast);
         fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr,
-                           sweep_takes_motion_bounds() ? &motion_bounds_ : nullptr);
+                           sweep_takes_motion_bounds() ? &motion_bounds_ : nullptr, blocks_.bounds);
     }
     blocks_.boxes_current = boxes;
     blocks_.current = false;  // the cloth's box is the union, made by the collision stage
@@ -311,7 +314,8 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile) {
     StageTimer timer(profile, Stage::BroadPhase);
     const int cols = topology_.cols;
     const std::size_t per_row = blocks_per_row(cols);
-    const BlockBounds bounds = block_bounds_for(settings_.colliders);
+    const BlockBounds bounds = block_bounds_for(settings_.colliders, blocks_);
+    blocks_.bounds = bounds;
     blocks_.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
     fast_.solver->for_each_block([&](int, int begin, int end) {
         for (int r = begin; r < end; ++r) {

@@ -33,6 +33,17 @@ Box reference_bounds(const DVec3Array& p, std::size_t begin, std::size_t end) {
     return b;
 }
 
+// n free particles of mass 1 at the origin, at rest.
+State free_state(std::size_t n) {
+    State st;
+    st.position.resize(n);
+    st.motion.resize(n);
+    st.mass.assign(n, 1.0f);
+    st.inverse_mass.assign(n, 1.0f);
+    st.pinned.assign(n, 0);
+    return st;
+}
+
 // The substep's motion of the probed particles: for friction to act on, and a path for the swept test.
 const glm::vec3 kMotion(0.001f, -0.002f, 0.0005f);
 
@@ -423,12 +434,7 @@ TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of
     ColliderSettings colliders;
     colliders.sphere = {true, {0.0f, 5.0f, 0.0f}, 0.3f, 0.4f};  // out of reach
     std::mt19937 rng(8);
-    State st;
-    st.position.resize(100);
-    st.motion.resize(100);
-    st.mass.assign(100, 1.0f);
-    st.inverse_mass.assign(100, 1.0f);
-    st.pinned.assign(100, 0);
+    State st = free_state(100);
     for (std::size_t i = 0; i < 100; ++i) {
         st.position.set(i, random_vec(rng, 1.0f));
         st.motion.set(i, 0.01f * random_vec(rng, 1.0f));
@@ -598,12 +604,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
     std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
     for (std::size_t size : {std::size_t{1}, std::size_t{7}, kBlockParticles, std::size_t{64}}) {
         INFO("blocks of " << size);
-        State culled;
-        culled.position.resize(600);
-        culled.motion.resize(600);
-        culled.mass.assign(600, 1.0f);
-        culled.inverse_mass.assign(600, 1.0f);
-        culled.pinned.assign(600, 0);
+        State culled = free_state(600);
         for (std::size_t i = 0; i < 600; ++i) {
             culled.position.set(i, {x(rng), y(rng), z(rng)});
             culled.motion.set(i, {m(rng), m(rng), m(rng)});
@@ -649,12 +650,7 @@ TEST_CASE("broad_phase collide_stage shared by threads moves every particle exac
     const std::size_t n = 4 * kParallelCollisionParticles + 333;  // the ground's threshold too
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
-    State start;
-    start.position.resize(n);
-    start.motion.resize(n);
-    start.mass.assign(n, 1.0f);
-    start.inverse_mass.assign(n, 1.0f);
-    start.pinned.assign(n, 0);
+    State start = free_state(n);
     std::vector<float> xs(n);
     for (float& v : xs) v = x(rng);
     std::sort(xs.begin(), xs.end());

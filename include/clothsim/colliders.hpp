@@ -51,12 +51,14 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
 
 // The particles as blocks (broad_phase.hpp: block_starts), each block's box and the whole cloth's box.
 //
-// The carried box holds every particle from substep to substep without a pass over them: a substep's sweep
-// moves each particle by its motion, so the box grown by the motion's bounds (and by zero: it keeps where the
-// particles started) holds them after it, and their paths. Tethers keep it (each moves a particle toward its
-// pin, within the box); any other move (a collider's push, a limit, self-collision, an edit) makes it
-// invalid until the next whole boxes. While it lies out of reach of the sphere, the cube and the cylinder,
-// the blocks need only their lowest points (for the ground) and those colliders cost one test each.
+// The carried box holds every particle, and the start of its path over the substep (x - motion, where the
+// swept tests begin), from substep to substep without a pass over them: a substep's sweep moves each particle
+// by its motion, so the box grown by the motion's bounds (and by zero: it keeps where the particles started)
+// holds them after it. A tether keeps its particle in it (it moves the particle toward its pin) and moves its
+// path's start by at most its motion, which the box grows by (MassSpring::step); any other move (a collider's
+// push, a limit, self-collision, an edit) and any substep without a sphere, cube or cylinder make it invalid
+// until the next whole boxes. While it lies out of reach of those colliders, the blocks need only their
+// lowest points (for the ground) and those colliders cost one test each.
 struct CollisionBlocks {
     std::vector<std::size_t> start;  // block k is particles [start[k], start[k + 1])
     std::vector<Box> boxes;          // one per block
@@ -85,7 +87,7 @@ struct CollisionBlocks {
 // takes them while it writes the motions): the swept boxes' reach then costs no pass over the motions.
 //
 // With Lowest boxes from the caller and the sphere, the cube or the cylinder enabled, those test the carried
-// box, grown here by `motion` (null: the particles moved since only in ways that keep it); when it may reach
+// box, grown here by `motion` (null: the caller has kept it since the sweep); when it may reach
 // one of them, or cannot be grown (a NaN motion), the stage makes whole boxes itself.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,

@@ -326,6 +326,7 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     }
     const std::size_t count = blocks.count();
     const bool shapes = any_shape(colliders);
+    if (!shapes) blocks.carried_valid = false;  // grown only while a shape may need it
     if (!shapes && !colliders.ground.enabled) return false;
     const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     const bool known = motion && !motion->empty && finite(motion->lo) && finite(motion->hi);
@@ -356,8 +357,9 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         // (x - motion), so a particle that passed through the sphere, the cube or the cylinder in one substep is still
         // offered to it (continuous collision). One bound for the cloth costs one vectorised pass, not one
         // per block; the ground (a half-space: nothing passes through it unseen) needs none.
-        // The caller's bounds, rounded to float as particle_bounds rounds them, give the same reach; bounds
-        // that are not finite (a NaN motion, which the pass leaves out) are taken again by the pass.
+        // The caller's bounds (NaN motions left out, as the pass leaves them), rounded to float as
+        // particle_bounds rounds them, give the same reach; bounds that are not finite (no motion that is a
+        // number, or an infinite one) are taken again by the pass.
         glm::vec3 reach(0.0f);
         if (shapes && blocks.bounds == BlockBounds::Box) {
             const Box bounds = known ? Box{glm::vec3(motion->lo), glm::vec3(motion->hi)}

@@ -302,13 +302,13 @@ void reset_lanes(double* lanes) {
     std::fill(lanes + 24, lanes + 48, -INFINITY);
 }
 
-// As MINPD and MAXPD (which return their second operand when either is NaN), a NaN value takes its lane's
-// bound until the lane's (or, in the vector forms, its running chain's) next value, and may be kept or
-// dropped where the chains are joined; the bounds of a cloth that is not finite are the guard's concern.
+// NaN values are left out, as a pass over the motions leaves them (include_motion): each bound is taken as
+// MINPD and MAXPD take it, the new value first, and they return their second operand, the running bound,
+// when either is NaN. The lanes never hold NaN, so where they are joined the order does not matter.
 void widen_tail(const double* m, int c, int n, double* lo, double* hi) {
     for (; c < n; ++c) {
-        lo[c & 7] = lo[c & 7] < m[c] ? lo[c & 7] : m[c];
-        hi[c & 7] = hi[c & 7] > m[c] ? hi[c & 7] : m[c];
+        lo[c & 7] = m[c] < lo[c & 7] ? m[c] : lo[c & 7];
+        hi[c & 7] = m[c] > hi[c & 7] ? m[c] : hi[c & 7];
     }
 }
 
@@ -706,8 +706,8 @@ template <FastKernel K, unsigned Mask, bool Ext>
                 const V step = load<V>(m + col) * keep + change;
                 store(m + col, step);
                 store(x + col, load<V>(x + col) + step);
-                low = low < step ? low : step;
-                high = high > step ? high : step;
+                low = step < low ? step : low;  // NaN left out (widen_tail)
+                high = step > high ? step : high;
             };
             // The substep's changes (f w + g) h2 (0 where pinned) of the columns from `col` in a float vector
             // like `narrow`, widened to double in one vector like `wide`, twice its width.

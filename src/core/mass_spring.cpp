@@ -217,6 +217,14 @@ void MassSpring::step() {
             limited = limit_speed(h) || limited;
         }
         if (self_moved || limited) blocks_.carried_valid = false;  // pushes and limits may leave it; tethers do not
+        if (plan_.tethers && tethers_at_limit_ > 0 && blocks_.carried_valid) {
+            // A tether keeps its particle in the carried box but takes the outward part of its motion, which
+            // moves the start of its path (x - motion, where the swept tests begin) by at most that motion.
+            const double largest = swept_bounds && !collided ? motion_bounds_.largest() : NAN;
+            blocks_.carried_valid = std::isfinite(largest);
+            blocks_.carried_lo -= glm::dvec3(largest);
+            blocks_.carried_hi += glm::dvec3(largest);
+        }
         blocks_.current = false;
         blocks_.boxes_current = box_blocks_on_team(profile);
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
@@ -332,7 +340,10 @@ bool MassSpring::sweep_takes_motion_bounds() const {
 }
 
 bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
-    if (!plan_.any_collider()) return false;
+    if (!plan_.any_collider()) {
+        blocks_.carried_valid = false;  // not grown while no stage reads it
+        return false;
+    }
     return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads(),
                          motion);
 }

@@ -371,8 +371,12 @@ TEST_CASE("broad_phase the carried box holds every particle, and the blocks hold
                 const State& st = fast.state();
                 const CollisionBlocks& blocks = fast.collision_blocks();
                 REQUIRE(blocks.boxes_current);
-                if (blocks.carried_valid) {
-                    for (std::size_t i = 0; i < st.size(); ++i) outside += !inside(blocks.carried_lo, blocks.carried_hi, st.position.get(i));
+                if (blocks.carried_valid) {  // every particle and the start of its path (x - motion)
+                    for (std::size_t i = 0; i < st.size(); ++i) {
+                        const glm::dvec3 x = st.position.get(i);
+                        outside += !inside(blocks.carried_lo, blocks.carried_hi, x);
+                        outside += !inside(blocks.carried_lo, blocks.carried_hi, x - st.motion.get(i));
+                    }
                 }
                 // Whole boxes are the blocks' bounds swept by the cloth's largest motion; lowest points are open boxes.
                 const Box motion = particle_bounds(st.motion, 0, st.size());
@@ -421,6 +425,34 @@ TEST_CASE("broad_phase a cloth moved into the sphere between steps is pushed out
         for (std::size_t i = 0; i < sim.state().size(); ++i) {
             if (sim.state().pinned[i]) continue;
             inside_sphere += glm::length(sim.state().position.get(i) - centre) <
+                             sphere.radius + sim.settings().colliders.thickness - 1e-5;
+        }
+        CHECK(inside_sphere == 0);
+        runs.push_back(std::move(sim));
+    }
+    CHECK(test::bit_identical(runs[0], runs[1]));
+}
+
+TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has moved, is not culled", "[broad_phase]") {
+    // While no sphere, cube or cylinder is enabled the carried box is not grown: it must not survive to the
+    // next one. The cloth swings down with the sphere off; the sphere comes back around its middle.
+    std::vector<MassSpring> runs;
+    for (bool broad_phase : {true, false}) {
+        INFO("broad phase " << broad_phase);
+        MassSpring sim = build_simulation(hanging_over_sphere(1, broad_phase, 0.0f));
+        sim.run_steps(3);
+        if (broad_phase) REQUIRE(sim.collision_blocks().bounds == BlockBounds::Lowest);
+        test::edit_settings(sim, [](SimulationSettings& s) { s.colliders.sphere.enabled = false; });
+        sim.run_steps(25);
+        const glm::vec3 middle(sim.state().position.get(40 * 20 + 20));
+        test::edit_settings(sim, [&](SimulationSettings& s) {
+            s.colliders.sphere = SphereCollider{true, middle + glm::vec3(0.0f, 0.0f, 0.02f), 0.1f, 0.3f};
+        });
+        sim.step();
+        const SphereCollider& sphere = sim.settings().colliders.sphere;
+        int inside_sphere = 0;
+        for (std::size_t i = 0; i < sim.state().size(); ++i) {
+            inside_sphere += glm::length(sim.state().position.get(i) - glm::dvec3(sphere.center)) <
                              sphere.radius + sim.settings().colliders.thickness - 1e-5;
         }
         CHECK(inside_sphere == 0);

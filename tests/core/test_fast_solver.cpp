@@ -362,6 +362,37 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
     }
 }
 
+TEST_CASE("fast solver: the motion bounds its sweep takes leave NaN motions out, as a pass over the motions does",
+          "[fast_solver]") {
+    // The collision stage takes the swept boxes' reach and grows the carried box from these bounds: a NaN
+    // motion must not hide a finite one. Column c uses lane c mod 8: a large motion at column 3 and a NaN one
+    // at column 11 of the same row share a lane, and so do the tail's columns (40 = 2 x 16 + 8 with AVX-512).
+    test::with_every_kernel([] {
+        Scene scene = per_spring_scene("drape-sphere");
+        auto [sim, solver] = moving(scene, 40);
+        for (int threads : {1, 3}) {
+            scene.settings.solver.threads = threads;
+            State state = sim.state();
+            for (std::size_t row : {5u, 30u}) {
+                state.motion.y[row * 40 + 3] = -0.5;  // far beyond any other particle's motion
+                state.motion.z[row * 40 + 35] = 0.5;
+                state.position.x[row * 40 + 11] = NAN;  // NaN motions at columns 10-12 after the substep
+                state.position.x[row * 40 + 39] = NAN;
+            }
+            MotionBounds b;
+            solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, &b);
+            MotionBounds pass;
+            include_motion(state.motion, 0, state.size(), pass);
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            REQUIRE(std::isnan(state.motion.x[5 * 40 + 11]));
+            CHECK(b.lo == pass.lo);
+            CHECK(b.hi == pass.hi);
+            CHECK(b.lo.y < -0.4);
+            CHECK(b.hi.z > 0.4);
+        }
+    });
+}
+
 TEST_CASE("fast solver: the motion bounds its sweep takes are those of every particle's new motion, for every kernel "
           "and thread count, and taking them changes no position", "[fast_solver]") {
     test::with_every_kernel([] {

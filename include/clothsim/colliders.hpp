@@ -22,6 +22,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -69,6 +70,12 @@ struct CollisionBlocks {
     glm::dvec3 carried_lo{0.0}, carried_hi{0.0};  // the carried box (above), in double: it grows every substep
     bool carried_valid = false;
     Box carried() const { return Box{glm::vec3(carried_lo), glm::vec3(carried_hi)}; }
+    // Grows the carried box by `by` on every side; drops it when `by` is not a number that bounds anything.
+    void widen_carried(double by) {
+        carried_valid = carried_valid && std::isfinite(by);
+        carried_lo -= glm::dvec3(by);
+        carried_hi += glm::dvec3(by);
+    }
     // Scratch of collide_stage: the blocks a collider tests, and which of them its pushes grew.
     std::vector<std::uint32_t> tested;
     std::vector<std::uint8_t> grown;
@@ -88,7 +95,7 @@ struct CollisionBlocks {
 //
 // With Lowest boxes from the caller and the sphere, the cube or the cylinder enabled, those test the carried
 // box, grown here by `motion` (null: the caller has kept it since the sweep); when it may reach
-// one of them, or cannot be grown (a NaN motion), the stage makes whole boxes itself.
+// one of them, or cannot be grown (bounds that are not finite), the stage makes whole boxes itself.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr);

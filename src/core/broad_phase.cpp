@@ -88,8 +88,8 @@ Box lowest_box(double lowest) {
 }
 
 double lowest_generic(const double* y, std::size_t n) {
-    double lo = INFINITY;
-    for (std::size_t i = 0; i < n; ++i) lo = y[i] < lo ? y[i] : lo;  // NaN left out
+    double lo = INFINITY, hi = -INFINITY;
+    bounds_generic(y, n, lo, hi);  // NaN left out
     return lo;
 }
 

@@ -220,10 +220,7 @@ void MassSpring::step() {
         if (plan_.tethers && tethers_at_limit_ > 0 && blocks_.carried_valid) {
             // A tether keeps its particle in the carried box but takes the outward part of its motion, which
             // moves the start of its path (x - motion, where the swept tests begin) by at most that motion.
-            const double largest = swept_bounds && !collided ? motion_bounds_.largest() : NAN;
-            blocks_.carried_valid = std::isfinite(largest);
-            blocks_.carried_lo -= glm::dvec3(largest);
-            blocks_.carried_hi += glm::dvec3(largest);
+            blocks_.widen_carried(swept_bounds && !collided ? motion_bounds_.largest() : NAN);
         }
         blocks_.current = false;
         blocks_.boxes_current = box_blocks_on_team(profile);

@@ -156,11 +156,26 @@ public:
     // caller can keep a limit until then.
     std::uint64_t setup_stamp() const { return setup_stamp_; }
 
+    // Sets every particle's mass (kg) in place, keeping positions and velocities (a material's density or
+    // cloth.mass changed live): pinned particles keep inverse mass 0, absent ones mass 0. Throws
+    // std::invalid_argument when `mass` has another length or a present particle's mass is not positive and
+    // finite (nothing changes then).
+    void set_masses(std::span<const float> mass);
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
     // Moves a pinned particle to `position` (a grab, a moving anchor); it carries no velocity of its own, its
     // springs pull on its neighbours from the new place at the next step. Does nothing to a free particle.
     void move_pinned(std::size_t i, glm::vec3 position);
+    // A user's drag of pinned particle `i` toward `target`: each substep moves the pin by at most
+    // kPinStepPerSubstep of the cloth's particle spacing toward it, the speed an explicit solver follows (the
+    // Courant-Friedrichs-Lewy condition: a disturbance crosses at most one spacing per substep), so a
+    // drag never stretches the pin's springs by more than that in one substep, whatever the frame rate. The
+    // pin keeps going until it reaches the target; calling again moves the target. Wakes the cloth. Does
+    // nothing to a free particle; freeing the pin drops its target.
+    void drag_pin(std::size_t i, glm::vec3 target);
+    static constexpr double kPinStepPerSubstep = 0.25;
+    // Where a dragged pin is heading (nothing when it is not dragged or has arrived).
+    std::optional<glm::vec3> pin_target(std::size_t i) const;
     // A user's grab: free particle `i` is pulled toward `target` by a stiff, critically damped spring whose
     // force is capped (grab_force_limit), the way cloth follows the mouse in Blender or Ten Minute Physics,
     // instead of being teleported. Its stiffness is a quarter of m / h^2 (w h = 0.5 for the particle alone,
@@ -221,6 +236,10 @@ private:
     void build_fast_solver();
     void check_sleep(double h);
     glm::vec3 grab_force(const State& state) const;
+    // N: the grab's force cap for particle i at the current masses and stiffness (grab()).
+    float grab_force_limit(std::size_t i) const;
+    // The first stage of a substep: dragged pins step toward their targets (drag_pin). Returns whether any moved.
+    bool move_dragged_pins();
 
     // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
     struct FastSolverHolder {
@@ -290,6 +309,11 @@ private:
         float force_limit = 0.0f;  // N
     };
     std::optional<Grab> grab_;
+    struct PinTarget {
+        std::size_t particle = 0;
+        glm::dvec3 target{0.0};  // m
+    };
+    std::vector<PinTarget> pin_targets_;  // pins dragged toward a target (drag_pin), at most a few
     Vec3Array grab_external_;    // N: the grab's and soft clips' forces (zero elsewhere), for the fast solver
 };
 

@@ -21,6 +21,8 @@
 
 namespace clothsim {
 
+struct ShapeMask;
+
 // A scene that cannot be loaded, overridden or built. The message names the source (file and line, or the
 // --set flag), the field, the value and what is allowed.
 class SceneError : public std::runtime_error {
@@ -52,6 +54,8 @@ const FieldInfo* find_field(std::string_view name);
 std::string describe_allowed(const FieldInfo& field);
 // A field's current value as TOML text ("[0.0, -9.81, 0.0]", "\"top-corners\"").
 std::string format_value(const Scene& scene, const FieldInfo& field);
+// Sets `field` of `to` to its value in `from` (the panel's "reset to scene value / built-in default").
+void copy_field(const FieldInfo& field, const Scene& from, Scene& to);
 
 // ---- Names of the enumerations, as written in files. ----
 std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
@@ -116,5 +120,14 @@ struct ClipWeight {
 std::vector<ClipWeight> soft_clip_weights(const ClothSettings& cloth, const PinSpec& pins);
 // The particles, springs and triangles of the grid, and the ready-to-step simulation. Throws SceneError.
 MassSpring build_simulation(const Scene& scene);
+// Each particle's mass (kg): a quarter of each cell around it times material.density in the material form,
+// cloth.mass shared equally in the per-spring form; 0 for the slots outside the shape.
+std::vector<float> particle_masses(const Scene& scene, const ShapeMask& shape);
+// The fabric of `scene` (cloth.mass and springs.structural/shear/bending, or its [material]) put on the
+// running cloth `sim`, built from a scene of the same grid: every particle's mass and every spring's and
+// bend's k re-derived in place (MassSpring::set_masses, MassSpring::apply), positions and velocities kept.
+// What the panel's fabric controls do live. Throws SceneError, changing nothing, when the grid differs, the
+// form switches between bends and skip-one springs (both need a rebuild) or the material is not valid.
+void apply_fabric(MassSpring& sim, const Scene& scene);
 
 }  // namespace clothsim

@@ -110,8 +110,11 @@ bool rebuild(AppState& app, Renderer& renderer, const Scene& scene) {
 bool report_guard(AppState& app, const StepReport& report) {
     if (report.steps > 0 && !report.guard_gave_up) app.failures_in_a_row = 0;
     if (report.guard_log.empty()) return false;
-    app.say(report.guard_log, report.guard_gave_up);
-    if (!report.guard_gave_up) return false;
+    if (!report.guard_gave_up) {
+        app.say(report.guard_log);
+        return false;
+    }
+    // One message (printed once) with what the guard did and what happens now.
     app.sim.release_grab();
     app.grab.reset();
     if (++app.failures_in_a_row >= 2) {
@@ -214,7 +217,7 @@ void drag_grabbed(AppState& app, const Window& window, float scale) {
     const Grab& grab = *app.grab;
     const auto p = intersect_plane(cursor_ray(app, window, scale), grab.plane_point, grab.plane_normal);
     if (!p) return;
-    if (grab.was_pinned) app.sim.move_pinned(grab.particle, *p);
+    if (grab.was_pinned) app.sim.drag_pin(grab.particle, *p);
     else app.sim.grab(grab.particle, *p);
 }
 
@@ -292,16 +295,43 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     if (ground.enabled) app.camera.keep_above(ground.height);
 }
 
-// Key presses and dropped files collected by GLFW callbacks. ImGui 1.86 (before its 1.87 input queue) sees
-// only the key state at each frame, so a tap shorter than a frame would be lost; the queue keeps every press.
+// Key presses and dropped files collected by GLFW callbacks, in front of Dear ImGui's own. ImGui 1.86 (before
+// its 1.87 input queue) reads each key's state once a frame, in NewFrame, so a key pressed and released
+// between two frames (a quick tap at a low frame rate) never reaches it: Enter would not end a typed value.
+// The queue hands ImGui the press at once and holds back a release of a key pressed since the last frame
+// until that frame has seen the key down, so every tap counts once.
 struct InputQueue {
-    std::vector<int> pressed;
+    std::vector<int> pressed;          // this frame's presses, for the app's own keys
     std::vector<std::string> dropped;  // paths dropped onto the window since the last frame
+    GLFWkeyfun imgui_key = nullptr;    // ImGui's key callback, which this queue feeds
+    struct Release {
+        int key, scancode, mods;
+    };
+    std::vector<int> down_this_frame;   // keys pressed since the last frame
+    std::vector<Release> held_releases; // their releases, handed to ImGui after the frame
 };
 
-void on_key(GLFWwindow* window, int key, int, int action, int) {
-    if (action != GLFW_PRESS) return;
-    if (auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window))) queue->pressed.push_back(key);
+void on_key(GLFWwindow* window, int key, int scancode, int action, int mods) {
+    auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
+    if (!queue) return;
+    if (action == GLFW_PRESS) {
+        queue->pressed.push_back(key);
+        queue->down_this_frame.push_back(key);
+    }
+    if (action == GLFW_RELEASE &&
+        std::find(queue->down_this_frame.begin(), queue->down_this_frame.end(), key) != queue->down_this_frame.end()) {
+        queue->held_releases.push_back({key, scancode, mods});
+        return;
+    }
+    if (queue->imgui_key) queue->imgui_key(window, key, scancode, action, mods);
+}
+
+// Before the next events are read: the releases held back reach ImGui, which saw their keys down last frame.
+void release_held_keys(GLFWwindow* window, InputQueue& queue) {
+    queue.down_this_frame.clear();
+    for (const InputQueue::Release& r : std::exchange(queue.held_releases, {})) {
+        if (queue.imgui_key) queue.imgui_key(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+    }
 }
 
 void on_drop(GLFWwindow* window, int count, const char** paths) {
@@ -467,9 +497,16 @@ void apply_requests(AppState& app, Renderer& renderer, const Window& window, flo
             app.say("loaded " + *requests.load);
         }
     }
-    if (requests.reset && rebuild(app, renderer, app.loaded)) {
-        app.stepper = Stepper(app.start_policy);  // R also restores auto substeps if the guard turned it off
-        app.say("reset to the start of " + app.scene.name);
+    if (requests.reset || requests.revert) {
+        // R returns to the start of the document as edited (its pins, grid and settings), with the substeps
+        // the scene asked for: those auto substeps or the guard chose are no edit. Revert returns to the file.
+        Scene start = requests.revert ? app.loaded : app.document();
+        start.settings.integration.substeps = app.loaded.settings.integration.substeps;
+        if (rebuild(app, renderer, start)) {
+            app.stepper = Stepper(app.start_policy);  // auto substeps back on if the guard turned it off
+            app.say(requests.revert ? "reverted to " + app.scene_source + ", as saved"
+                                    : "reset to the start of " + app.scene.name + " as edited");
+        }
     }
     if (requests.rebuild) rebuild(app, renderer, *requests.rebuild);
     if (requests.save) save_scene(app, *requests.save);
@@ -529,11 +566,11 @@ void start_imgui(const Window& window, InputQueue& input, float scale) {
     io.Fonts->AddFontDefault(&font);
     ImGui::StyleColorsDark();
     ImGui::GetStyle().ScaleAllSizes(scale);
-    // Installed before ImGui's, which chains to it.
     glfwSetWindowUserPointer(window.get(), &input);
-    glfwSetKeyCallback(window.get(), on_key);
     glfwSetDropCallback(window.get(), on_drop);
     ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
+    // In front of ImGui's key callback, which the queue then feeds (InputQueue).
+    input.imgui_key = glfwSetKeyCallback(window.get(), on_key);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 }
 
@@ -581,6 +618,7 @@ PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window
 void merge_requests(PanelRequests& into, const PanelRequests& panel) {
     if (panel.rebuild) into.rebuild = panel.rebuild;
     into.reset |= panel.reset;
+    into.revert |= panel.revert;
     into.frame_camera |= panel.frame_camera;
     into.reset_camera |= panel.reset_camera;
     into.screenshot |= panel.screenshot;
@@ -704,6 +742,7 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
     auto last = Clock::now();
     const auto started = last;
     while (!glfwWindowShouldClose(window.get())) {
+        release_held_keys(window.get(), input);
         glfwPollEvents();
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();

@@ -135,7 +135,7 @@ struct AppState {
     // The document: name, cloth and pins as edited, what Reset returns to (`loaded`). The live settings are
     // the simulation's alone; document() joins the two into what "Save scene as" writes.
     Scene scene;
-    Scene loaded;             // the scene as loaded (after --set): "reset to scene value" and R go back here
+    Scene loaded;             // the scene as loaded (after --set) or saved: "reset to scene value" and Revert go here
     std::string scene_source; // bundled name or path it came from
     MassSpring sim;           // the running cloth; owns the live settings (MassSpring::apply)
     Stepper stepper;          // the run policy: fixed step, catch-up cap, auto substeps, the guard
@@ -173,7 +173,8 @@ struct AppState {
 // What the panel asks the app to do after this frame.
 struct PanelRequests {
     std::optional<Scene> rebuild;  // cloth or pins changed: rebuild from this edited scene
-    bool reset = false;         // back to the loaded scene's start
+    bool reset = false;         // back to the start of the document as edited (R)
+    bool revert = false;        // back to the scene as loaded or saved, dropping every edit
     bool frame_camera = false;
     bool reset_camera = false;
     bool screenshot = false;

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <type_traits>
 #include <variant>
 
@@ -37,6 +38,7 @@ constexpr SliderHint kHints[] = {
     {"forces.max_speed", 0.0f, 100.0f, false}, {"solver.sleep_speed", 0.0f, 0.1f, true},
     {"solver.sleep_time", 0.0f, 10.0f, false}, {"colliders.contact_stiffness", 10.0f, 1e6f, true},
     {"material.density", 0.01f, 2.0f, true},  {"material.shear", 0.0f, 1e5f, true},
+    {"material.stretch", 1.0f, 1e5f, true},   {"material.bending", 0.0f, 1e-2f, true},
     {"collision.self_thickness", 0.0f, 0.1f, false}, {"collision.self_friction", 0.0f, 2.0f, false},
     {"springs.tear_strain", 0.0f, 2.0f, false},
 };
@@ -59,15 +61,6 @@ void tooltip(const FieldInfo& f) {
     ImGui::TextDisabled("ctrl+click to type a value; right-click to reset");
     ImGui::PopTextWrapPos();
     ImGui::EndTooltip();
-}
-
-// Copies one field's value from `from` into `to`.
-void copy_field(const FieldInfo& f, const Scene& from, Scene& to) {
-    std::visit([&](auto* dst) { std::visit([&](const auto* src) {
-                   if constexpr (std::is_same_v<std::remove_pointer_t<decltype(dst)>,
-                                                std::remove_const_t<std::remove_pointer_t<decltype(src)>>>) *dst = *src;
-               }, f.read(from)); },
-               f.ref(to));
 }
 
 // A combo box over an enumeration's names (as written in scene files); true when the user picked one.
@@ -159,6 +152,10 @@ bool value_widget(Scene& edit, const FieldInfo& f) {
             [&](float* v) { return float_widget(label, f, v); },
             [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
             [&](glm::vec2* v) {
+                if (const SliderHint* h = hint_for(f.name)) {
+                    return ImGui::SliderFloat2(label.c_str(), &v->x, h->lo, h->hi, "%.4g",
+                                               h->logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
+                }
                 // Stiffnesses span decades: a drag moves them by a fraction of their size.
                 const bool stiffness = f.name == "material.stretch" || f.name == "material.bending" ||
                                        f.name.starts_with("springs.");
@@ -238,52 +235,80 @@ void note_edit(Scene& edit, const FieldInfo& f) {
     }
 }
 
-// Draws every field of `edit` whose name starts with `prefix`; returns true when any changed.
+// One field's row: its widget with tooltip and reset controls, its range check and the material
+// bookkeeping; returns true when the user changed it.
+bool field_row(Scene& edit, AppState& app, const FieldInfo& f) {
+    // Auto substeps owns the substeps field: greyed out so an edit is not silently overwritten.
+    const bool owned = app.stepper.policy().auto_substeps && f.name == "integration.substeps";
+    // A solver setting the chosen integrator does not read stays editable but dimmed (as Blender shows an
+    // inactive property), and its tooltip says so.
+    const Integrator integrator = edit.settings.integration.integrator;
+    const bool unused = (f.name == "integration.tolerance" && !uses_tolerance(integrator)) ||
+                        (f.name == "integration.iterations" && !uses_iterations(integrator));
+    bool changed = false;
+    if (owned) ImGui::BeginDisabled();
+    if (unused) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, ImGui::GetStyle().Alpha * 0.45f);
+    if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
+        keep_in_range(app, edit, f);
+        note_edit(edit, f);
+        changed = true;
+    }
+    if (unused) {
+        ImGui::PopStyleVar();
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("%s does not read %s",
+                              std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
+                              std::string(f.name).c_str());
+        }
+    }
+    if (owned && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+        ImGui::SetTooltip("auto substeps chooses integration.substeps (Integration: untick it to set them)");
+    }
+    if (owned) ImGui::EndDisabled();
+    return changed;
+}
+
+// The fields the fabric part of the Springs section draws (fabric_section), left out of the other sections.
+bool is_fabric_field(std::string_view name) {
+    return name == "cloth.mass" || name == "springs.structural" || name == "springs.shear" ||
+           name == "springs.bending" || name.starts_with("material.");
+}
+
+// Draws every field of `edit` whose name starts with `prefix` (the fabric's apart); returns true when any changed.
 bool fields_section(Scene& edit, AppState& app, std::string_view prefix) {
     bool changed = false;
     for (const FieldInfo& f : scene_fields()) {
-        if (!f.name.starts_with(prefix) || f.name == "material.preset" || f.name == "material.enabled") continue;
-        // Auto substeps owns the substeps field, and a material the per-spring values: greyed out so an edit
-        // is not silently overwritten.
-        const bool owned = (app.stepper.policy().auto_substeps && f.name == "integration.substeps") ||
-                           (edit.material.enabled && !field_is_written(edit, f.name));
-        // A solver setting the chosen integrator does not read stays editable but dimmed (as Blender shows an
-        // inactive property), and its tooltip says so.
-        const Integrator integrator = edit.settings.integration.integrator;
-        const bool unused = (f.name == "integration.tolerance" && !uses_tolerance(integrator)) ||
-                            (f.name == "integration.iterations" && !uses_iterations(integrator));
-        if (owned) ImGui::BeginDisabled();
-        if (unused) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, ImGui::GetStyle().Alpha * 0.45f);
-        if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
-            keep_in_range(app, edit, f);
-            note_edit(edit, f);
-            changed = true;
-        }
-        if (unused) {
-            ImGui::PopStyleVar();
-            if (ImGui::IsItemHovered()) {
-                ImGui::SetTooltip("%s does not read %s",
-                                  std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
-                                  std::string(f.name).c_str());
-            }
-        }
-        if (owned && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled) && edit.material.enabled &&
-            !f.name.starts_with("integration.")) {
-            ImGui::SetTooltip("%s is derived from [material] on this grid", std::string(f.name).c_str());
-        }
-        if (owned) ImGui::EndDisabled();
+        if (!f.name.starts_with(prefix) || is_fabric_field(f.name)) continue;
+        changed |= field_row(edit, app, f);
     }
     return changed;
 }
 
-// The fabric: per-spring values, a material of the scene's own, or a measured preset (material.hpp). A
-// choice rebuilds the cloth (masses change); the material's fields follow when it has one.
-bool material_section(Scene& edit, AppState& app) {
+// Draws the named fields of `edit` in this order; returns true when any changed.
+bool named_fields(Scene& edit, AppState& app, std::initializer_list<std::string_view> names) {
     bool changed = false;
+    for (std::string_view name : names) changed |= field_row(edit, app, *find_field(name));
+    return changed;
+}
+
+// What an edit of the fabric asks for.
+enum class FabricEdit {
+    None,
+    Live,     // new values: masses and springs' k re-derived in place (apply_fabric)
+    Rebuild,  // between the per-spring form and a material: bends replace skip-one springs
+};
+
+// The fabric, the cloth's mass and stiffness: per-spring values, a material of the scene's own, or a measured
+// preset (material.hpp). Their values are live: the same cloth goes on moving with the new masses and
+// constants. On a material the controls are the material's, in physical units, with the per-spring values
+// they give on this grid beneath; on a per-spring cloth they are cloth.mass and the springs' k.
+FabricEdit fabric_section(Scene& edit, AppState& app) {
+    FabricEdit result = FabricEdit::None;
     const MaterialSettings& m = edit.material;
     const std::string current = !m.enabled ? "per spring" : m.preset.empty() ? "custom material" : m.preset;
     if (ImGui::BeginCombo("fabric", current.c_str())) {
         auto choose = [&](const std::string& name) {
+            const bool was_material = edit.material.enabled;
             if (name == "per spring") {
                 // Back to springs: the loaded scene's when it had them, else those derived on this grid (as
                 // --set material.enabled=false does).
@@ -299,9 +324,11 @@ bool material_section(Scene& edit, AppState& app) {
                 edit.per_spring_fields = 0;
                 edit.material.enabled = true;
                 edit.material.preset = name == "custom material" ? "" : name;
+                // A preset is the whole fabric: every one of its fields, none of the scene's kept.
+                if (!edit.material.preset.empty()) edit.material.explicit_fields = 0;
                 note_edit(edit, *find_field("material.preset"));
             }
-            changed = true;
+            result = was_material == edit.material.enabled ? FabricEdit::Live : FabricEdit::Rebuild;
         };
         for (const char* name : {"per spring", "custom material"}) {
             if (ImGui::Selectable(name, current == name)) choose(name);
@@ -316,10 +343,14 @@ bool material_section(Scene& edit, AppState& app) {
     if (ImGui::IsItemHovered()) {
         ImGui::SetTooltip("per spring: cloth.mass and springs.* as numbers per spring (a finer grid is another "
                           "fabric);\nmaterial: density, stretch, shear and bending in physical units, the same "
-                          "fabric at every resolution (docs/MATERIAL.md)");
+                          "fabric at every resolution (docs/MATERIAL.md).\nValues change live; switching between "
+                          "per spring and a material rebuilds the cloth");
     }
+    if (result != FabricEdit::None) return result;
     if (edit.material.enabled) {
-        changed |= fields_section(edit, app, "material.");
+        if (named_fields(edit, app, {"material.density", "material.stretch", "material.shear", "material.bending"})) {
+            result = FabricEdit::Live;
+        }
         try {
             const SpringConstants k = spring_constants(edit.cloth, edit.material);
             ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g, bends %.4g / %.4g N/m",
@@ -329,8 +360,25 @@ bool material_section(Scene& edit, AppState& app) {
         } catch (const SceneError& e) {
             ImGui::TextWrapped("%s", e.what());
         }
+    } else if (named_fields(edit, app, {"cloth.mass", "springs.structural", "springs.shear", "springs.bending"})) {
+        result = FabricEdit::Live;
     }
-    return changed;
+    return result;
+}
+
+// A live fabric edit reaches the running cloth (apply_fabric) and the document; one the cloth cannot take
+// (a material the grid cannot hold) changes nothing and says why.
+void put_fabric(AppState& app, Scene& edit) {
+    try {
+        apply_fabric(app.sim, edit);
+    } catch (const SceneError& e) {
+        app.say(std::string("fabric not changed: ") + e.what(), true);
+        edit.settings.springs = app.sim.settings().springs;
+        return;
+    }
+    app.scene.material = edit.material;
+    app.scene.cloth.mass = edit.cloth.mass;
+    app.scene.per_spring_fields = edit.per_spring_fields;
 }
 
 void plot(const char* label, const History& h, ImVec4 color) {
@@ -479,6 +527,10 @@ void scene_section(AppState& app, PanelRequests& requests) {
     }
     ImGui::SameLine();
     if (ImGui::Button("Reset (R)")) requests.reset = true;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the start of the scene as edited: pins, grid and settings kept");
+    ImGui::SameLine();
+    if (ImGui::Button("Revert")) requests.revert = true;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the scene as loaded or last saved, dropping every edit");
     ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx",
                        ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");
@@ -718,15 +770,21 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) scene_section(app, requests);
     bool cloth_changed = false;
     if (ImGui::CollapsingHeader("Cloth")) {
-        ImGui::TextDisabled("changes rebuild the cloth");
+        ImGui::TextDisabled("grid, shape and pins: changes rebuild the cloth");
         cloth_changed |= fields_section(edit, app, "cloth.");
-        cloth_changed |= material_section(edit, app);
         cloth_changed |= fields_section(edit, app, "pins");
     }
-    if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) fields_section(edit, app, "springs.");
+    FabricEdit fabric = FabricEdit::None;
+    if (ImGui::CollapsingHeader("Springs", ImGuiTreeNodeFlags_DefaultOpen)) {
+        fabric = fabric_section(edit, app);
+        ImGui::Separator();
+        fields_section(edit, app, "springs.");
+    }
     if (ImGui::CollapsingHeader("Forces")) forces_section(edit, app);
     if (ImGui::CollapsingHeader("Integration", ImGuiTreeNodeFlags_DefaultOpen)) integration_section(edit, app);
     if (ImGui::CollapsingHeader("Colliders")) colliders_section(edit, app);
+    if (fabric == FabricEdit::Live) put_fabric(app, edit);
+    cloth_changed |= fabric == FabricEdit::Rebuild;
     app.sim.apply(edit.settings);
     if (cloth_changed) requests.rebuild = edit;
     if (ImGui::CollapsingHeader("View")) view_section(app, requests);

@@ -176,6 +176,53 @@ std::vector<ClipWeight> soft_clip_weights(const ClothSettings& cloth, const PinS
     return out;
 }
 
+std::vector<float> particle_masses(const Scene& scene, const ShapeMask& shape) {
+    const ClothSettings& cloth = scene.cloth;
+    const std::size_t n = static_cast<std::size_t>(cloth.rows) * cloth.cols;
+    std::vector<float> mass(n, 0.0f);
+    if (scene.material.enabled) {
+        // Each cell's mass density x h_u x h_v goes a quarter to each corner (material.hpp).
+        const glm::dvec2 h = grid_spacing(cloth);
+        const double quarter = 0.25 * double(scene.material.density) * h.x * h.y;
+        for (int r = 0; r < cloth.rows; ++r) {
+            for (int c = 0; c < cloth.cols; ++c) {
+                const int cells = shape.has_cell(r - 1, c - 1) + shape.has_cell(r - 1, c) + shape.has_cell(r, c - 1) +
+                                  shape.has_cell(r, c);
+                mass[static_cast<std::size_t>(r) * cloth.cols + c] = static_cast<float>(quarter * cells);
+            }
+        }
+    } else {
+        // The total shared equally by the particles of the shape.
+        const float share = cloth.mass / static_cast<float>(shape.particle_count);
+        for (std::size_t i = 0; i < n; ++i) mass[i] = shape.particle[i] ? share : 0.0f;
+    }
+    return mass;
+}
+
+void apply_fabric(MassSpring& sim, const Scene& scene) {
+    const Topology& topology = sim.topology();
+    if (topology.rows != scene.cloth.rows || topology.cols != scene.cloth.cols) {
+        throw SceneError("the fabric of a " + std::to_string(scene.cloth.rows) + " x " +
+                         std::to_string(scene.cloth.cols) + " cloth cannot be put on the running " +
+                         std::to_string(topology.rows) + " x " + std::to_string(topology.cols) + " one: rebuild it");
+    }
+    // The material form has bends where the per-spring form has skip-one springs: another topology.
+    const std::size_t skip_one = topology.spring_count_by_kind[int(SpringKind::Bending)] - topology.bends.size();
+    if (scene.material.enabled ? skip_one > 0 : !topology.bends.empty()) {
+        throw SceneError(std::string("switching between [material] and per-spring values changes the bending "
+                                     "elements (bends or skip-one springs): rebuild the cloth"));
+    }
+    if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
+    Scene derived = scene;
+    derive_springs(derived);  // throws for a grid [material] cannot fill
+    SimulationSettings settings = sim.settings();
+    settings.springs.structural = derived.settings.springs.structural;
+    settings.springs.shear = derived.settings.springs.shear;
+    settings.springs.bending = derived.settings.springs.bending;
+    sim.set_masses(particle_masses(derived, shape_mask(derived.cloth)));
+    sim.apply(settings);
+}
+
 MassSpring build_simulation(const Scene& scene) {
     validate(scene);
     const ClothSettings& cloth = scene.cloth;
@@ -195,23 +242,7 @@ MassSpring build_simulation(const Scene& scene) {
         }
     }
     const ShapeMask shape = shape_mask(cloth);
-    state.mass.assign(n, 0.0f);
-    if (scene.material.enabled) {
-        // Each cell's mass density x h_u x h_v goes a quarter to each corner (material.hpp).
-        const glm::dvec2 h = grid_spacing(cloth);
-        const double quarter = 0.25 * double(scene.material.density) * h.x * h.y;
-        for (int r = 0; r < cloth.rows; ++r) {
-            for (int c = 0; c < cloth.cols; ++c) {
-                const int cells = shape.has_cell(r - 1, c - 1) + shape.has_cell(r - 1, c) + shape.has_cell(r, c - 1) +
-                                  shape.has_cell(r, c);
-                state.mass[static_cast<std::size_t>(r) * cloth.cols + c] = static_cast<float>(quarter * cells);
-            }
-        }
-    } else {
-        // The total shared equally by the particles of the shape.
-        const float share = cloth.mass / static_cast<float>(shape.particle_count);
-        for (std::size_t i = 0; i < n; ++i) state.mass[i] = shape.particle[i] ? share : 0.0f;
-    }
+    state.mass = particle_masses(scene, shape);
     state.inverse_mass.resize(n);
     state.pinned.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {

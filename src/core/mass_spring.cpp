@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace clothsim {
 
@@ -150,6 +151,7 @@ void MassSpring::apply(const SimulationSettings& settings) {
         }
     }
     settings_ = settings;
+    if (grab_) grab_->force_limit = grab_force_limit(grab_->particle);  // it follows the springs' k
     replan();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
     // Self-collision's list and budget say nothing of what the cloth did while the stage was off or set
@@ -179,6 +181,11 @@ void MassSpring::step() {
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
     const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
     if (!continues) blocks_.carried_valid = false;     // an edit may have moved particles out of it
+    // A dragged pin moves outside the motions the broad phase and self-collision count.
+    if (!pin_targets_.empty() && move_dragged_pins()) {
+        blocks_.carried_valid = false;
+        if (self_collision_) self_collision_->invalidate();
+    }
     // Self-collision's list of near pairs holds while only steps move the particles (self_collision.hpp).
     if (!continues && self_collision_) self_collision_->invalidate();
 
@@ -440,7 +447,7 @@ void MassSpring::check_sleep(double h) {
     const double step_limit = settings_.solver.sleep_speed * elapsed;
     const double substep_limit = kSubstepFactor * settings_.solver.sleep_speed * h;
     const double step2 = step_limit * step_limit, substep2 = substep_limit * substep_limit;
-    bool calm = true;
+    bool calm = pin_targets_.empty();  // a pin still on its way drives the cloth
     for (std::size_t i = 0; i < n && calm; ++i) {
         if (state_.pinned[i]) continue;
         const glm::dvec3 d = state_.position.get(i) - sleep_reference_.get(i);
@@ -599,17 +606,21 @@ void MassSpring::grab(std::size_t i, glm::vec3 target) {
     if (state_.pinned.at(i)) return;
     wake();
     if (!grab_ || grab_->particle != i) {
-        // The cap: what stretches the particle's own springs by half their rest length, at least 10 m |g|.
-        float springs = 0.0f;
-        for (const Spring& s : topology_.springs) {
-            if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s) * s.rest_length;
-        }
-        const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
-        grab_ = Grab{i, target, std::max(0.5f * springs, floor)};
+        grab_ = Grab{i, target, grab_force_limit(i)};
         grab_external_ = Vec3Array{};
         grab_external_.resize(state_.size());
     }
     grab_->target = target;
+}
+
+// The cap: what stretches the particle's own springs by half their rest length, at least 10 m |g|.
+float MassSpring::grab_force_limit(std::size_t i) const {
+    float springs = 0.0f;
+    for (const Spring& s : topology_.springs) {
+        if (s.a == i || s.b == i) springs += stiffness_of(settings_.springs, s) * s.rest_length;
+    }
+    const float floor = 10.0f * state_.mass[i] * std::max(glm::length(settings_.forces.gravity), 9.81f);
+    return std::max(0.5f * springs, floor);
 }
 
 void MassSpring::release_grab() {
@@ -737,6 +748,32 @@ bool MassSpring::all_finite() const {
     return true;
 }
 
+void MassSpring::set_masses(std::span<const float> mass) {
+    const std::size_t n = state_.size();
+    if (mass.size() != n) {
+        throw std::invalid_argument("MassSpring::set_masses: " + std::to_string(mass.size()) + " masses for " +
+                                    std::to_string(n) + " particles");
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state_.pinned[i] != kAbsent && !(std::isfinite(mass[i]) && mass[i] > 0.0f)) {
+            throw std::invalid_argument("MassSpring::set_masses: particle " + std::to_string(i) + " would have mass " +
+                                        std::to_string(mass[i]) + " kg; allowed: finite and > 0");
+        }
+    }
+    if (std::equal(mass.begin(), mass.end(), state_.mass.begin())) return;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (state_.pinned[i] == kAbsent) continue;
+        state_.mass[i] = mass[i];
+        state_.inverse_mass[i] = state_.pinned[i] ? 0.0f : 1.0f / mass[i];
+    }
+    // The motion (x - x_prev, or v h) is kept: velocities carry over, and the new masses act from the next
+    // substep. The projective matrix holds the masses; the stability limit and the grab's cap follow them.
+    iterative_.invalidate();
+    if (grab_) grab_->force_limit = grab_force_limit(grab_->particle);
+    wake();
+    setup_stamp_ = next_stamp();
+}
+
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
     if (state_.pinned.at(i) == kAbsent) return;  // outside the cloth's shape: no particle to pin or free
     if (pinned && grab_ && grab_->particle == i) release_grab();
@@ -757,6 +794,45 @@ void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
     stamp_ = next_stamp();
     state_.position.set(i, glm::dvec3(position));
     state_.motion.set(i, glm::dvec3(0.0));
+}
+
+void MassSpring::drag_pin(std::size_t i, glm::vec3 target) {
+    if (state_.pinned.at(i) != kPinned) return;
+    wake();
+    for (PinTarget& t : pin_targets_) {
+        if (t.particle == i) {
+            t.target = glm::dvec3(target);
+            return;
+        }
+    }
+    pin_targets_.push_back({i, glm::dvec3(target)});
+}
+
+std::optional<glm::vec3> MassSpring::pin_target(std::size_t i) const {
+    for (const PinTarget& t : pin_targets_) {
+        if (t.particle == i) return glm::vec3(t.target);
+    }
+    return std::nullopt;
+}
+
+bool MassSpring::move_dragged_pins() {
+    const double reach = kPinStepPerSubstep * spacing_;
+    bool moved = false;
+    std::erase_if(pin_targets_, [&](const PinTarget& t) {
+        if (state_.pinned[t.particle] != kPinned) return true;  // freed since
+        const glm::dvec3 x = state_.position.get(t.particle);
+        const glm::dvec3 d = t.target - x;
+        const double length = glm::length(d);
+        if (!(length > reach)) {  // arrives this substep (a NaN target is dropped where the pin is)
+            if (std::isfinite(length)) state_.position.set(t.particle, t.target);
+            moved = moved || length > 0.0;
+            return true;
+        }
+        state_.position.set(t.particle, x + d * (reach / length));
+        moved = true;
+        return false;
+    });
+    return moved;
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {

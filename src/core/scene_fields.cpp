@@ -183,6 +183,17 @@ ConstFieldRef FieldInfo::read(const Scene& scene) const {
     return std::visit([](auto* field) -> ConstFieldRef { return field; }, ref(const_cast<Scene&>(scene)));
 }
 
+void copy_field(const FieldInfo& field, const Scene& from, Scene& to) {
+    // Both variants hold the same alternative (one accessor). The types are named as template parameters: a
+    // test of decltype(dst) against decltype(src) inside the nested generic lambdas built, with GCC 12, into a
+    // copy that never ran (the panel's reset did nothing; test_scene_file.cpp checks every field).
+    std::visit([&]<class T>(T* dst) {
+        std::visit([&]<class U>(const U* src) {
+            if constexpr (std::is_same_v<T, U>) *dst = *src;
+        }, field.read(from));
+    }, field.ref(to));
+}
+
 std::string format_value(const Scene& scene, const FieldInfo& field) {
     // A TOML basic string: quotes, backslashes and control characters escaped (TOML 1.0, "String").
     auto quoted = [](std::string_view text) {

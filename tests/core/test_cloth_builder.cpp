@@ -1,11 +1,16 @@
 // The cloth builder: grid placement along the axes, spring counts and rest lengths per kind, mass, triangles.
 #include "support.hpp"
 
+#include "clothsim/material.hpp"
+#include "clothsim/stability.hpp"
+
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
 #include <cmath>
 #include <set>
+#include <utility>
+#include <vector>
 
 using namespace clothsim;
 
@@ -174,3 +179,143 @@ TEST_CASE("cloth_builder: a clip holds the particles within its radius of the bu
     CHECK(pinned == 19);
 }
 
+
+namespace {
+
+// The scene with every material field scaled (stretch, shear and bending by `stiffer`, density by `heavier`),
+// or in the per-spring form cloth.mass and the springs' k.
+Scene fabric_scaled(const Scene& scene, float stiffer, float heavier) {
+    Scene s = scene;
+    if (s.material.enabled) {
+        s.material.stretch *= stiffer;
+        s.material.shear *= stiffer;
+        s.material.bending *= stiffer;
+        s.material.density *= heavier;
+        s.material.explicit_fields = kMaterialDensity | kMaterialStretch | kMaterialShear | kMaterialBending;
+        derive_springs(s);
+    } else {
+        s.settings.springs.structural *= stiffer;
+        s.settings.springs.shear *= stiffer;
+        s.settings.springs.bending *= stiffer;
+        s.cloth.mass *= heavier;
+    }
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("apply_fabric: on every bundled scene, the masses and constants of a cloth built with the new fabric, "
+          "positions and velocities kept",
+          "[cloth_builder][fabric]") {
+    for (const std::string& name : bundled_scene_names()) {
+        INFO(name);
+        const Scene scene = test::scene_for_loops(name);
+        MassSpring sim = build_simulation(scene);
+        sim.run_steps(3);
+        for (const auto& [stiffer, heavier] : {std::pair{10.0f, 2.0f}, std::pair{0.1f, 0.5f}}) {
+            const Scene changed = fabric_scaled(scene, stiffer, heavier);
+            const MassSpring built = build_simulation(changed);
+            const MassSpring before = sim;
+            const std::uint64_t stamp = sim.change_stamp();
+            apply_fabric(sim, changed);
+            CHECK(test::bit_identical(sim, before));  // positions and motion (x - x_prev): no restart
+            CHECK(sim.change_stamp() == stamp);
+            CHECK(sim.state().mass == built.state().mass);
+            CHECK(std::equal(sim.state().inverse_mass.begin(), sim.state().inverse_mass.end(),
+                             built.state().inverse_mass.begin(), built.state().inverse_mass.end()));
+            CHECK(sim.settings().springs == built.settings().springs);
+            for (std::size_t h = 0; h < sim.topology().holds.size(); ++h) {  // soft clips follow the stiffness
+                CHECK(sim.topology().holds[h].stiffness == built.topology().holds[h].stiffness);
+            }
+            // As the app's auto substeps does: a stiffer fabric needs shorter substeps.
+            sim.set_substeps(auto_substeps(stability_limit(sim), sim.settings().integration.dt, 0.5f,
+                                           scene.settings.integration.substeps));
+            sim.run_steps(2);
+            CHECK(sim.all_finite());
+        }
+    }
+}
+
+TEST_CASE("apply_fabric: a hanging cloth stiffened live settles where a cloth built stiff settles", "[cloth_builder][fabric]") {
+    // A 12 x 12 cotton-weight sheet hanging from its top corners, stretchy (60 N/m) so that its sag is large,
+    // heavily damped (c = 8/s: the slowest swing decays as e^(-4 t)) so that 5 s settle it to 1e-6 m.
+    Scene soft = load_scene("hanging");
+    soft.cloth.rows = soft.cloth.cols = 12;
+    soft.material.stretch = {60.0f, 60.0f};
+    soft.material.shear = 6.0f;
+    soft.material.explicit_fields |= kMaterialStretch | kMaterialShear;
+    soft.settings.springs.damping = 8.0f;
+    soft.settings.springs.tether_strain = 0.0f;
+    soft.settings.colliders.ground.enabled = false;
+    derive_springs(soft);
+    const Scene stiff = fabric_scaled(soft, 10.0f, 1.0f);
+    // One substep for both, inside the stiff cloth's limit.
+    const int substeps = auto_substeps(stability_limit(build_simulation(stiff)), stiff.settings.integration.dt, 0.5f);
+    const long long steps = static_cast<long long>(5.0 / stiff.settings.integration.dt);
+    auto lowest = [](const MassSpring& s) {
+        double y = INFINITY;
+        for (std::size_t i = 0; i < s.particle_count(); ++i) y = std::min(y, s.state().position.y[i]);
+        return y;
+    };
+    MassSpring live = build_simulation(soft);
+    live.set_substeps(substeps);
+    live.run_steps(steps);
+    const double soft_low = lowest(live);
+    // Stiffened while it hangs: the next substeps move it as continuously as the steps before did.
+    double fastest = 0.0;
+    for (const glm::vec3& v : live.velocities()) fastest = std::max(fastest, double(glm::length(v)));
+    const std::vector<glm::vec3> before = live.positions();
+    apply_fabric(live, stiff);
+    live.run_steps(1);
+    const double step = stiff.settings.integration.dt;
+    for (std::size_t i = 0; i < before.size(); ++i) {
+        // From rest (|v| < 1e-5 m/s), a step moves a particle by at most about g dt^2 / 2 and what the new
+        // springs do in it: far less than a restart, which puts the cloth back at its flat start.
+        CHECK(glm::length(live.position(i) - before[i]) <= fastest * step + 10.0 * 9.81 * step * step);
+    }
+    live.run_steps(steps);
+    MassSpring built = build_simulation(stiff);
+    built.set_substeps(substeps);
+    built.run_steps(2 * steps);
+    CHECK(soft_low < lowest(built) - 0.05);  // the soft sheet hangs more than 5 cm lower
+    CHECK(lowest(live) == Approx(lowest(built)).margin(1e-5));
+}
+
+TEST_CASE("apply_fabric: refuses another grid or another form, changing nothing", "[cloth_builder][fabric]") {
+    const Scene scene = load_scene("hanging");
+    MassSpring sim = build_simulation(scene);
+    sim.run_steps(2);
+    const MassSpring copy = sim;
+    Scene other_grid = scene;
+    other_grid.cloth.rows += 1;
+    CHECK_THROWS_WITH(apply_fabric(sim, other_grid), Catch::Contains("rebuild"));
+    Scene per_spring = scene;
+    per_spring.material = MaterialSettings{};
+    CHECK_THROWS_WITH(apply_fabric(sim, per_spring), Catch::Contains("rebuild"));
+    Scene too_dense = scene;
+    too_dense.material.density = std::nanf("");
+    CHECK_THROWS(apply_fabric(sim, too_dense));
+    CHECK(test::bit_identical(sim, copy));
+    CHECK(sim.state().mass == copy.state().mass);
+    CHECK(sim.settings() == copy.settings());
+}
+
+TEST_CASE("set_masses: keeps velocities, so the kinetic energy scales with the mass; refuses bad masses", "[fabric]") {
+    MassSpring sim = build_simulation(load_scene("falling"));
+    sim.run_steps(10);
+    const double kinetic = sim.energy().kinetic;
+    REQUIRE(kinetic > 0.0);
+    std::vector<float> heavier = sim.state().mass;
+    for (float& m : heavier) m *= 3.0f;
+    sim.set_masses(heavier);
+    CHECK(sim.energy().kinetic == Approx(3.0 * kinetic).epsilon(1e-6));
+    const std::vector<float> kept = sim.state().mass;
+    std::vector<float> bad = kept;
+    bad[1] = 0.0f;
+    CHECK_THROWS_WITH(sim.set_masses(bad), Catch::Contains("particle 1"));
+    bad[1] = std::nanf("");
+    CHECK_THROWS(sim.set_masses(bad));
+    bad.pop_back();
+    CHECK_THROWS_WITH(sim.set_masses(bad), Catch::Contains("masses for"));
+    CHECK(sim.state().mass == kept);
+}

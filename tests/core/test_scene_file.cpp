@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <string>
 #include <type_traits>
+#include <typeinfo>
 #include <variant>
 #include <vector>
 
@@ -982,4 +983,32 @@ TEST_CASE("scene file: the contact model and its stiffness load, override, round
     CHECK_THAT(no_shell, Contains("test.toml:2:") && Contains("colliders.thickness") && Contains("penalty"));
     CHECK_THAT(override_error(unchanged, "colliders.thickness=0"), Contains("colliders.thickness"));
     CHECK_NOTHROW(parse_scene("[colliders]\nthickness = 0.0\n", "test.toml"));  // projection allows it
+}
+
+TEST_CASE("scene copy_field: every field of every kind takes the other scene's value (the panel's reset)") {
+    using namespace clothsim;
+    // The sources: every bundled scene; the target: the built-in defaults. Every field that differs is copied
+    // alone and must then read as in the source, with every other field of the target untouched.
+    std::vector<std::string> kinds_copied;
+    int copies = 0;
+    for (const std::string& name : bundled_scene_names()) {
+        const Scene source = load_scene(name);
+        for (const FieldInfo& f : scene_fields()) {
+            const Scene defaults{};
+            if (format_value(defaults, f) == format_value(source, f)) continue;
+            Scene target{};
+            copy_field(f, source, target);
+            INFO(name << ": " << f.name);
+            CHECK(format_value(target, f) == format_value(source, f));
+            for (const FieldInfo& other : scene_fields()) {
+                if (other.name != f.name) CHECK(format_value(target, other) == format_value(defaults, other));
+            }
+            ++copies;
+            kinds_copied.push_back(std::visit([](const auto* p) { return std::string(typeid(*p).name()); }, f.read(source)));
+        }
+    }
+    std::sort(kinds_copied.begin(), kinds_copied.end());
+    kinds_copied.erase(std::unique(kinds_copied.begin(), kinds_copied.end()), kinds_copied.end());
+    CHECK(copies > 50);
+    CHECK(kinds_copied.size() >= 7);  // int, float, bool, vec2, vec3, string, pins and enumerations among them
 }

@@ -54,6 +54,21 @@ struct GuardSettings {
     int max_retries = 6;               // each retry doubles the substeps
 };
 
+// Why a step fails the guard's check: the first of its three criteria that it breaks.
+enum class BlowUp { None, NonFinite, Strain, Energy };
+
+// What each BlowUp is called in the guard's log and the CLI's messages ("" for None).
+const char* blow_up_name(BlowUp cause);
+
+// The guard's check of the step just run, from the total energy before it (J). `energy` is the total energy
+// after it (J; inf when not finite), the next step's `energy_before`. run_guarded and the headless run
+// (src/app/headless.cpp) both call this, so a step one calls a blow-up the other does too.
+struct StepCheck {
+    BlowUp blow_up = BlowUp::None;
+    double energy = 0.0;
+};
+StepCheck check_step(const MassSpring& sim, double energy_before, const GuardSettings& guard);
+
 // Runs `steps` steps; when a step fails the check it rolls back to the state before that step, doubles
 // integration.substeps and retries. Each change is described in `log` (one line each). Returns false when
 // the retries ran out (the simulation is then left at the last good state, never NaN).

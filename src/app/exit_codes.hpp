@@ -6,7 +6,9 @@ namespace clothsim {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitBadInput = 2;    // a bad flag, scene or output path; no display or OpenGL 3.3; a
                                            // missing shader or texture
-inline constexpr int kExitNonFinite = 3;   // the simulation became non-finite (or the guard gave up)
+inline constexpr int kExitBlowUp = 3;      // the simulation blew up: a step failed the guard's check (non-finite
+                                           // positions, strain or an energy jump beyond GuardSettings in
+                                           // clothsim/stability.hpp), or --guard ran out of retries
 inline constexpr int kExitGlError = 4;     // an OpenGL error in a scripted (--frames) run
 
 }  // namespace clothsim

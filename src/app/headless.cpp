@@ -105,26 +105,42 @@ std::string open_outputs(const HeadlessOptions& options, const MassSpring& sim,
 struct RunOutcome {
     long long steps = 0;
     bool finite = true;
-    bool guard_ok = true;
+    BlowUp blow_up = BlowUp::None;  // why the last step failed the guard's check (without --guard)
+    bool guard_ok = true;           // with --guard: false when it ran out of retries
     std::string guard_log;
     double wall_seconds = 0.0;
+
+    bool blew_up() const { return blow_up != BlowUp::None || !guard_ok; }
+    const char* cause() const { return guard_ok ? blow_up_name(blow_up) : "the guard gave up"; }
 };
 
 // The run itself: one step at a time through the stepper (so the trajectory can record any step), until
-// `steps`, a non-finite cloth, or a guard that gave up.
+// `steps` or a blow-up. Without --guard each step gets the guard's check (check_step), so a cloth the guard
+// would roll back stops the run there, finite or not: a blow-up held finite by tethers (1e9 J and more) is
+// still a blow-up. With --guard the guard itself checks and retries.
 RunOutcome simulate(MassSpring& sim, Stepper& stepper, long long steps, const HeadlessOptions& options,
                     TrajectoryWriter* trajectory) {
     RunOutcome run;
     const auto start = std::chrono::steady_clock::now();
+    const GuardSettings& guard = stepper.policy().guard_settings;
     run.finite = sim.all_finite();
-    while (run.finite && run.guard_ok && run.steps < steps) {
+    if (!run.finite) run.blow_up = BlowUp::NonFinite;
+    double energy = run.finite ? sim.energy().total() : 0.0;  // J at the start of the next step
+    while (!run.blew_up() && run.steps < steps) {
         const StepReport report = stepper.run(sim, 1);
         if (!report.guard_log.empty()) std::cerr << report.guard_log;
         run.guard_log += report.guard_log;
         run.guard_ok = !report.guard_gave_up;
         ++run.steps;
         run.finite = sim.all_finite();
-        if (trajectory && (run.steps % options.every == 0 || run.steps == steps || !run.finite)) {
+        if (!options.guard) {
+            const StepCheck check = check_step(sim, energy, guard);
+            run.blow_up = check.blow_up;
+            energy = check.energy;
+        } else if (!run.finite) {
+            run.blow_up = BlowUp::NonFinite;
+        }
+        if (trajectory && (run.steps % options.every == 0 || run.steps == steps || run.blew_up())) {
             trajectory->record(run.steps, sim);
         }
     }
@@ -132,8 +148,62 @@ RunOutcome simulate(MassSpring& sim, Stepper& stepper, long long steps, const He
     return run;
 }
 
+// What sets the critical substep (StabilityLimit::bound, and the wind's limit folded into it), for messages.
+const char* bound_source(const StabilityLimit& limit) {
+    if (limit.wind_substep <= limit.critical_substep) return "the wind's drag";
+    switch (limit.bound) {
+        case StabilityBound::Springs: return "the springs";
+        case StabilityBound::Damping: return "the damping (c h < 2)";
+        case StabilityBound::Contact: return "penalty contact";
+        case StabilityBound::Clips: return "the soft clips";
+    }
+    return "the springs";
+}
+
+// The substep in force against the safe (Gershgorin) stability bound, critical_substep of stability.hpp, in
+// words ("substep 0.0167 s is above the stability bound 0.000231 s of the springs"), with what brings it within:
+// the substeps of auto_substeps at safety 1, ceil(dt / bound), or, where even kMaxSubsteps is not enough, a
+// smaller dt. An integrator stable at any substep (implicit Euler without contact or clips) has no bound, nor
+// has a cloth without springs.
+struct SubstepCheck {
+    bool above = false;
+    std::string text;            // where the substep stands
+    std::string fix;             // what brings it within the bound ("" when it is within)
+    bool substeps_fix = false;   // `fix` is a number of substeps, which --auto-substeps would choose too
+};
+SubstepCheck check_substep(const MassSpring& sim, const StabilityLimit& limit) {
+    SubstepCheck check;
+    const double substep = sim.substep_length();
+    char text[200];
+    if (limit.unconditionally_stable || !std::isfinite(limit.critical_substep)) {
+        std::snprintf(text, sizeof text, "substep %.3g s has no stability bound here (integration.integrator = %s)",
+                      substep,
+                      std::string(integrator_names()[static_cast<int>(sim.settings().integration.integrator)]).c_str());
+        check.text = text;
+        return check;
+    }
+    check.above = substep > limit.critical_substep;
+    std::snprintf(text, sizeof text, "substep %.3g s is %s the stability bound %.3g s of %s", substep,
+                  check.above ? "above" : "within", limit.critical_substep, bound_source(limit));
+    check.text = text;
+    if (check.above) {
+        const float dt = sim.settings().integration.dt;
+        const int needed = auto_substeps(limit, dt, 1.0f);
+        check.substeps_fix = double(dt) / needed <= limit.critical_substep;
+        if (check.substeps_fix) {
+            check.fix = "integration.substeps >= " + std::to_string(needed);
+        } else {
+            std::snprintf(text, sizeof text, "integration.dt <= %.3g s with integration.substeps = %d",
+                          kMaxSubsteps * limit.critical_substep, kMaxSubsteps);
+            check.fix = text;
+        }
+    }
+    return check;
+}
+
 // Closes the outputs (trajectory, OBJ) and says what failed; returns the exit code.
-int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutcome& run, TrajectoryWriter* trajectory) {
+int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit,
+           TrajectoryWriter* trajectory) {
     int code = kExitOk;
     if (trajectory && !trajectory->finish()) {
         std::cerr << "clothsim: error: " << trajectory->error() << "\n";
@@ -146,12 +216,16 @@ int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutco
             code = kExitBadInput;
         }
     }
-    if (!run.finite || !run.guard_ok) {
-        std::cerr << "clothsim: error: the simulation " << (run.finite ? "kept blowing up" : "became non-finite")
-                  << " at t = " << sim.time() << " s (step " << run.steps
-                  << "); try a smaller integration.dt, more integration.substeps, softer springs, or --guard / "
-                     "--auto-substeps\n";
-        code = kExitNonFinite;
+    if (run.blew_up()) {
+        // One line: when, why, and the substep against the bound known before stepping (the limit of the cloth
+        // as it started: its wind bound reads the cloth's area, which a blown-up cloth no longer has).
+        const SubstepCheck substep = check_substep(sim, limit);
+        const std::string advice =
+            !substep.above ? "try more integration.substeps, a smaller integration.dt, softer springs, or --guard"
+                           : "use " + substep.fix + (substep.substeps_fix ? " or --auto-substeps" : "");
+        std::fprintf(stderr, "clothsim: error: the simulation blew up at t = %.4g s (step %lld: %s): %s; %s\n",
+                     sim.time(), run.steps, run.cause(), substep.text.c_str(), advice.c_str());
+        code = kExitBlowUp;
     }
     return code;
 }
@@ -174,6 +248,8 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"simulated_seconds", sim.time()},
         {"wall_seconds", run.wall_seconds},
         {"finite", run.finite},
+        {"blew_up", run.blew_up()},
+        {"blow_up", run.blew_up() ? nlohmann::json(run.cause()) : nlohmann::json()},
         {"critical_substep", finite_or_null(limit.critical_substep)},
         {"substep", sim.substep_length()},
         {"guard_log", run.guard_log},
@@ -217,8 +293,9 @@ void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(), sim.spring_count());
     std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", run.steps,
                 sim.settings().integration.dt, sim.settings().integration.substeps, sim.time(), run.wall_seconds);
-    std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s\n", e.kinetic, e.potential(),
-                e.total(), run.finite ? "yes" : "no");
+    std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s; blew up: %s%s%s\n", e.kinetic,
+                e.potential(), e.total(), run.finite ? "yes" : "no", run.blew_up() ? "yes (" : "no",
+                run.cause(), run.blew_up() ? ")" : "");
     print_profile(sim.profile(), describe(sim.plan(), sim.topology(), sim.settings()), run.steps, sim.asleep());
 }
 
@@ -239,6 +316,13 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
                              "substep at %.2f of it\n",
                      limit.critical_substep, chosen, dt / chosen / limit.critical_substep);
     }
+    // Before stepping: a substep above the safe bound is not known to be stable (the measured limit lies within
+    // 1.6x of it, docs/STABILITY.md) and a blow-up is likely, which only --guard recovers from; said once, here,
+    // so a long run does not start silently toward its failure.
+    if (const SubstepCheck substep = check_substep(sim, limit); substep.above) {
+        std::cerr << "clothsim: warning: " << substep.text << " (" << substep.fix << " needed); expect a blow-up"
+                  << (policy.guard ? ", which --guard will retry with more substeps" : "") << "\n";
+    }
     const long long steps = options.steps ? *options.steps
                             : options.duration ? std::llround(*options.duration / dt)
                                                : std::llround(1.0 / dt);
@@ -248,7 +332,7 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
         return kExitBadInput;
     }
     const RunOutcome run = simulate(sim, stepper, steps, options, trajectory.get());
-    const int code = finish(options, sim, run, trajectory.get());
+    const int code = finish(options, sim, run, limit, trajectory.get());
     if (options.json) print_json(scene, sim, run, limit);
     else print_text(scene, sim, run);
     return code;

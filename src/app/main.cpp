@@ -9,8 +9,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <limits>
 
 namespace {
 
@@ -29,6 +33,64 @@ struct CommandLine {
     std::vector<std::string> view_items;
 };
 
+// What a numeric flag allows, for its check and its message: "a number > 0 (simulated seconds)".
+struct NumberRule {
+    bool whole = false;           // an integer
+    double min = 0.0;
+    bool min_excluded = false;    // > min rather than >= min
+    double max = std::numeric_limits<double>::infinity();
+    const char* meaning = "";     // what the number counts
+};
+
+// "> 0", ">= 0" or "in [1, 1000000000]" (%.10g: every bound here prints in full).
+std::string bounds_text(const NumberRule& rule) {
+    char text[80];
+    if (std::isfinite(rule.max)) {
+        std::snprintf(text, sizeof text, "in %c%.10g, %.10g]", rule.min_excluded ? '(' : '[', rule.min, rule.max);
+    } else {
+        std::snprintf(text, sizeof text, "%s %.10g", rule.min_excluded ? ">" : ">=", rule.min);
+    }
+    return text;
+}
+
+// A CLI11 transform whose message says what is allowed in one short line, after CLI11's "--FLAG: ", e.g.
+// "-1 is out of range: must be a number > 0 (simulated seconds)": CLI11's PositiveNumber and NonNegativeNumber
+// print their upper end, DBL_MAX, as a 309-digit number, and call "abc" out of range too. A whole number is
+// read in base 10 and handed on in plain decimal (a transform may rewrite the text; a check may not): CLI11
+// reads integers with strtoll base 0, which takes "010" for 8.
+CLI::Validator number_check(const NumberRule& rule) {
+    const std::string allowed = std::string("must be ") + (rule.whole ? "a whole number " : "a number ") +
+                                bounds_text(rule) + " (" + rule.meaning + ")";
+    return CLI::Validator(
+        [rule, allowed](std::string& text) -> std::string {
+            const std::string shown = text.size() <= 16 ? text : text.substr(0, 13) + "...";  // a short line
+            const char* begin = text.c_str();
+            char* end = nullptr;
+            errno = 0;
+            double value = 0.0;
+            if (rule.whole) {
+                const long long whole = std::strtoll(begin, &end, 10);
+                if (end == begin || *end != '\0') {
+                    const double number = std::strtod(begin, &end);
+                    if (end == begin || *end != '\0') return "'" + shown + "' is not a number: " + allowed;
+                    const char* why = number == std::trunc(number) ? "in plain digits" : "a whole number";
+                    return "'" + shown + "' is not " + why + ": " + allowed;
+                }
+                if (errno == ERANGE) return shown + " is out of range: " + allowed;
+                text = std::to_string(whole);
+                value = static_cast<double>(whole);
+            } else {
+                value = std::strtod(begin, &end);
+                if (end == begin || *end != '\0') return "'" + shown + "' is not a number: " + allowed;
+                if (!std::isfinite(value)) return shown + " is not a finite number: " + allowed;
+            }
+            const bool above_min = rule.min_excluded ? value > rule.min : value >= rule.min;
+            if (!above_min || value > rule.max) return shown + " is out of range: " + allowed;
+            return "";
+        },
+        bounds_text(rule));
+}
+
 // The flags (CLI11), bound to `cl`.
 void add_flags(CLI::App& app, CommandLine& cl) {
     auto* headless_flag = app.add_flag("--headless", cl.headless, "Simulate without a window and report on stdout");
@@ -37,29 +99,30 @@ void add_flags(CLI::App& app, CommandLine& cl) {
     app.add_option("scene", cl.scene_argument, "The same as --scene: a bundled scene name or a .toml file")
         ->excludes(scene);
     auto* duration = app.add_option("--duration", cl.options.duration, "Simulated seconds to run (default 1)")
-                         ->check(CLI::PositiveNumber);
-    auto* steps = app.add_option("--steps", cl.options.steps, "Steps of integration.dt to run")->check(CLI::NonNegativeNumber);
+                         ->transform(number_check({.min_excluded = true, .meaning = "simulated seconds"}));
+    auto* steps = app.add_option("--steps", cl.options.steps, "Steps of integration.dt to run")
+                      ->transform(number_check({.whole = true, .meaning = "steps of integration.dt"}));
     duration->excludes(steps);
     app.add_option("--set", cl.overrides, "Override a scene field: key=value (repeatable; see --list-fields)")
         ->take_all()
         ->allow_extra_args(false);
     auto* trajectory = app.add_option("--trajectory", cl.options.trajectory, "Write positions as CSV (step,time,particle,x,y,z)");
     app.add_option("--every", cl.options.every, "With --trajectory: record every K steps")
-        ->check(CLI::Range(1LL, 1000000000LL))
+        ->transform(number_check({.whole = true, .min = 1, .max = 1e9, .meaning = "steps between rows"}))
         ->needs(trajectory);
     app.add_option("--obj", cl.options.obj, "Write the final mesh as Wavefront OBJ");
     app.add_flag("--json", cl.options.json, "Print one JSON object with the run's figures on stdout");
     app.add_option("--auto-substeps", cl.options.auto_substeps,
                    "Choose integration.substeps so the substep is this fraction of the critical one (the app "
                    "does this by default at 0.5, except in --frames runs)")
-        ->check(CLI::Range(0.01f, 1.0f));
+        ->transform(number_check({.min = 0.01, .max = 1, .meaning = "x the critical substep"}));
     app.add_flag("--guard", cl.options.guard,
                  "Headless: when a step blows up, roll back, double integration.substeps and retry (says so)");
     app.add_flag("--list-scenes", cl.list_scenes, "List the bundled scenes and exit");
     app.add_flag("--list-fields", cl.list_fields, "List every scene field with its unit and allowed values, and exit");
     app.add_flag("--print-scene", cl.print_scene, "Print the scene (after --set) as TOML and exit");
     auto* frames = app.add_option("--frames", cl.app_options.frames, "App: run N frames (one step each), then exit")
-                       ->check(CLI::PositiveNumber);
+                       ->transform(number_check({.whole = true, .min = 1, .meaning = "frames of one step each"}));
     app.add_option("--screenshot", cl.app_options.screenshot, "App: with --frames, write the last frame as PNG")
         ->needs(frames);
     app.add_option("--record", cl.app_options.record,
@@ -68,7 +131,7 @@ void add_flags(CLI::App& app, CommandLine& cl) {
     app.add_flag("--paused", cl.app_options.start_paused, "App: start paused (Space or Play runs, S steps once)")
         ->excludes(headless_flag);
     app.add_option("--quit-after", cl.app_options.quit_after, "App: close the window after this many wall seconds")
-        ->check(CLI::PositiveNumber)
+        ->transform(number_check({.min_excluded = true, .meaning = "wall seconds"}))
         ->excludes(frames)
         ->excludes(headless_flag);
     app.add_option("--size", cl.size_text, "App: window size WxH in screen coordinates (default 1280x720)");

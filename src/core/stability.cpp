@@ -167,6 +167,26 @@ double max_strain(const MassSpring& sim) {
     return worst;
 }
 
+const char* blow_up_name(BlowUp cause) {
+    switch (cause) {
+        case BlowUp::None: return "";
+        case BlowUp::NonFinite: return "non-finite positions";
+        case BlowUp::Strain: return "max strain above the bound";
+        case BlowUp::Energy: return "energy jump above the bound";
+    }
+    return "";
+}
+
+StepCheck check_step(const MassSpring& sim, double energy_before, const GuardSettings& guard) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (!sim.all_finite()) return {BlowUp::NonFinite, kInf};
+    const double energy = sim.energy().total();
+    if (max_strain(sim) > guard.max_strain) return {BlowUp::Strain, energy};
+    const bool energy_ok = std::isfinite(energy) &&
+                           energy - energy_before <= guard.max_energy_growth * (std::fabs(energy_before) + 1.0);
+    return {energy_ok ? BlowUp::None : BlowUp::Energy, energy};
+}
+
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
     for (long long done = 0; done < steps; ++done) {
         if (sim.resting()) {  // asleep with nothing to wake it: the step moves nothing, there is nothing to check
@@ -178,22 +198,15 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
         int retries = 0;
         for (;;) {
             sim.run_steps(1);
-            const bool finite = sim.all_finite();
-            const double strain = finite ? max_strain(sim) : std::numeric_limits<double>::infinity();
-            const double energy = finite ? sim.energy().total() : std::numeric_limits<double>::infinity();
-            const bool energy_ok =
-                std::isfinite(energy) &&
-                energy - energy_before <= guard.max_energy_growth * (std::fabs(energy_before) + 1.0);
-            if (finite && strain <= guard.max_strain && energy_ok) break;
+            const BlowUp blow_up = check_step(sim, energy_before, guard).blow_up;
+            if (blow_up == BlowUp::None) break;
             const int substeps = sim.settings().integration.substeps;
             char line[256];
             if (retries >= guard.max_retries || substeps >= kMaxSubsteps) {
                 std::snprintf(line, sizeof line,
                               "guard: t = %.4g s: the step failed (%s) after %d retries; stopped at the last good "
                               "state\n",
-                              good.time(),
-                              !finite ? "non-finite positions" : (energy_ok ? "strain beyond the bound" : "energy blew up"),
-                              retries);
+                              good.time(), blow_up_name(blow_up), retries);
                 log += line;
                 sim = good;
                 return false;
@@ -203,10 +216,7 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
             std::snprintf(line, sizeof line,
                           "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
                           "from %d to %d\n",
-                          good.time(),
-                          !finite ? "non-finite positions" : (energy_ok ? "max strain above the bound" : "energy blew up"),
-                          substeps,
-                          sim.settings().integration.substeps);
+                          good.time(), blow_up_name(blow_up), substeps, sim.settings().integration.substeps);
             log += line;
             ++retries;
         }

@@ -1,10 +1,11 @@
 // The run policy: how time becomes steps of a MassSpring. The caller owns time (as in b2World_Step); the
 // Stepper decides how many whole steps of integration.dt to run and with how many substeps, in one place
 // that the desktop app and --headless both use:
-//  - fixed step: advance() adds simulated seconds to an accumulator and runs the whole steps it holds, at most
-//    max_catchup_steps per call, so a slow frame slows the simulation instead of spiralling (Fiedler, "Fix
-//    Your Timestep!", 2004); run() runs an exact number of steps (a single step, a scripted frame, a headless
-//    run);
+//  - fixed step: advance() adds simulated seconds to an accumulator and runs the whole steps it holds until
+//    they have taken frame_budget of wall time, so a slow frame slows the simulation instead of spiralling
+//    (Fiedler, "Fix Your Timestep!", 2004) and a frame never waits long on physics: the cap is time, not a
+//    count of steps, whatever a step costs (one step always runs when one is owed); run() runs an exact
+//    number of steps (a single step, a scripted frame, a headless run);
 //  - auto substeps: before stepping, integration.substeps is chosen so the substep is `safety` times the
 //    critical substep of the current cloth (stability.hpp, docs/STABILITY.md);
 //  - the guard: a step that blows up is rolled back and retried with twice the substeps (run_guarded). Auto
@@ -25,13 +26,15 @@ struct RunPolicy {
     float safety = 0.5f;         // ... so the substep is this fraction of it, in (0, 1]
     bool guard = false;          // roll back and retry with doubled substeps when a step blows up
     GuardSettings guard_settings;
-    int max_catchup_steps = 4;   // advance(): steps per call at most; the rest of the time is dropped
+    // s of wall time: advance() starts no further step once its steps have taken this long; the time still
+    // owed is dropped. 50 ms keeps a frame's physics within three frames of 60 Hz.
+    double frame_budget = 0.05;
 };
 
 // What one advance() or run() did.
 struct StepReport {
     long long steps = 0;           // steps run
-    double dropped_seconds = 0.0;  // simulated time dropped by the catch-up cap
+    double dropped_seconds = 0.0;  // simulated time dropped by the frame budget
     bool skipped_non_finite = false;  // nothing was stepped: the cloth is already non-finite
     bool guard_gave_up = false;    // the guard ran out of retries: the cloth is at the last good state
     std::string guard_log;         // the guard's changes and auto substeps turned off, one line each
@@ -44,10 +47,11 @@ public:
     const RunPolicy& policy() const { return policy_; }
     void set_auto_substeps(bool on) { policy_.auto_substeps = on; }
     void set_safety(float safety) { policy_.safety = safety; }
-    void set_max_catchup_steps(int steps) { policy_.max_catchup_steps = steps; }
+    void set_frame_budget(double seconds) { policy_.frame_budget = seconds; }
 
     // Adds `seconds` of simulated time and runs the whole steps of integration.dt it makes up (with what
-    // earlier calls left over), at most max_catchup_steps of them.
+    // earlier calls left over), one after another until they have taken frame_budget of wall time; the time
+    // still owed then is dropped (StepReport::dropped_seconds).
     StepReport advance(MassSpring& sim, double seconds);
     // Runs `steps` steps now.
     StepReport run(MassSpring& sim, long long steps);

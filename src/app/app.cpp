@@ -82,7 +82,8 @@ void record_energy(AppState& app) {
 void after_rebuild(AppState& app, Renderer& renderer) {
     app.grab.reset();
     app.stepper.restart();
-    app.stats.dropped_seconds = 0.0;
+    app.stats.speed = app.time_scale;
+    app.stats.window_wall = app.stats.window_simulated = 0.0;
     app.failures_in_a_row = 0;
     app.stats.kinetic.clear();
     app.stats.potential.clear();
@@ -111,7 +112,7 @@ bool report_guard(AppState& app, const StepReport& report) {
     if (report.steps > 0 && !report.guard_gave_up) app.failures_in_a_row = 0;
     if (report.guard_log.empty()) return false;
     if (!report.guard_gave_up) {
-        app.say(report.guard_log);
+        app.say(report.guard_log, false, true);  // a warning: the step was retried with more substeps
         return false;
     }
     // One message (printed once) with what the guard did and what happens now.
@@ -167,7 +168,18 @@ bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
                 true);
     }
     if (report.steps > 0) record_plots(app, was_resting && app.sim.resting());
-    app.stats.dropped_seconds += report.dropped_seconds;
+    if (!app.paused && !one_step_a_frame) {  // playing in real time: is it keeping up?
+        app.stats.window_wall += wall_seconds;
+        app.stats.window_simulated += double(report.steps) * app.sim.settings().integration.dt;
+        if (app.stats.window_wall >= 0.5) {
+            app.stats.speed = static_cast<float>(app.stats.window_simulated / app.stats.window_wall);
+            app.stats.window_wall = app.stats.window_simulated = 0.0;
+        }
+    } else {
+        app.stats.speed = app.time_scale;
+        app.stats.window_wall = app.stats.window_simulated = 0.0;
+    }
+    app.stats.frame_ms = static_cast<float>(1e3 * wall_seconds);
     app.stats.profile = app.sim.profile();
     app.stats.sim_ms = std::chrono::duration<float, std::milli>(Clock::now() - start).count();
     app.stats.substeps_last_frame = report.steps * app.sim.settings().integration.substeps;

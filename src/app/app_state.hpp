@@ -3,6 +3,7 @@
 #pragma once
 
 #include "camera.hpp"
+#include "layout.hpp"
 #include "file_browser.hpp"
 #include "file_dialog.hpp"
 #include "recent_files.hpp"
@@ -61,10 +62,14 @@ struct StageTimes {
 };
 
 struct Stats {
+    float frame_ms = 0.0f;   // wall time from the last frame's start to this one's
     float sim_ms = 0.0f;     // wall time of this frame's physics
     float render_ms = 0.0f;  // CPU time to issue this frame's drawing (scene and panel)
     long long substeps_last_frame = 0;
-    double dropped_seconds = 0.0;  // simulated time skipped because frames were too slow to catch up
+    // How fast the simulation keeps up while it plays: simulated seconds per wall second over the last
+    // half second or more (the time scale when it keeps up), and the sums of the window being measured.
+    float speed = 1.0f;
+    double window_wall = 0.0, window_simulated = 0.0;
     History kinetic, potential, total;
     StepProfile profile;     // this frame's stages (MassSpring::profile, reset every frame)
     StageTimes times;
@@ -138,7 +143,7 @@ struct AppState {
     Scene loaded;             // the scene as loaded (after --set) or saved: "reset to scene value" and Revert go here
     std::string scene_source; // bundled name or path it came from
     MassSpring sim;           // the running cloth; owns the live settings (MassSpring::apply)
-    Stepper stepper;          // the run policy: fixed step, catch-up cap, auto substeps, the guard
+    Stepper stepper;          // the run policy: fixed step, frame budget, auto substeps, the guard
     RunPolicy start_policy;   // ... as the app started with it: what R restores
     int failures_in_a_row = 0;  // guard failures with no good step between them
     OrbitCamera camera;
@@ -147,6 +152,7 @@ struct AppState {
     bool step_once = false;
     float time_scale = 1.0f;   // simulated seconds per wall second
     bool show_panel = true;
+    float panel_width = kPanelWidth;  // window coordinates at content scale 1; the user drags the panel's edge
     bool vsync = true;
     Stats stats;
     std::optional<Grab> grab;
@@ -162,9 +168,9 @@ struct AppState {
     // The scene as it runs: the document with the simulation's live settings (what Save writes).
     Scene document() const { return running_scene(scene, sim); }
 
-    // A message in the panel's message area; an error also goes to stderr.
-    void say(std::string message, bool error = false) {
-        if (messages.add(message, error) && error) {
+    // A message in the panel's message area; an error, or a warning (`to_stderr`), also goes to stderr.
+    void say(std::string message, bool error = false, bool to_stderr = false) {
+        if (messages.add(message, error) && (error || to_stderr)) {
             std::cerr << "clothsim: " << message << (message.ends_with('\n') ? "" : "\n");
         }
     }

@@ -80,10 +80,14 @@ bool enum_combo(const char* label, Enum* value, std::span<const std::string_view
     return edited;
 }
 
-// The label shown for a field: its last name component ("structural" for springs.structural).
+// The label shown for a field: its last name component in words, with its unit ("tether strain",
+// "damping (1/s)"); the dotted name is the tooltip's first line.
 std::string label_of(const FieldInfo& f) {
     const auto dot = f.name.rfind('.');
-    return std::string(dot == std::string_view::npos ? f.name : f.name.substr(dot + 1));
+    std::string label(dot == std::string_view::npos ? f.name : f.name.substr(dot + 1));
+    std::replace(label.begin(), label.end(), '_', ' ');
+    if (!f.unit.empty()) label += " (" + std::string(f.unit) + ")";
+    return label;
 }
 
 // A float field: a slider over the hinted extent (logarithmic where the range spans decades), else a drag.
@@ -353,9 +357,10 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
         }
         try {
             const SpringConstants k = spring_constants(edit.cloth, edit.material);
-            ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g, bends %.4g / %.4g N/m",
-                                k.structural.x, k.structural.y, k.shear, k.bending.x, k.bending.y);
-            ImGui::TextDisabled("Poisson ratio %.3f / %.3f", k.poisson_uv, k.poisson_vu);
+            ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g N/m", k.structural.x,
+                                k.structural.y, k.shear);
+            ImGui::TextDisabled("bends %.4g / %.4g N/m; Poisson ratio %.3f / %.3f", k.bending.x, k.bending.y,
+                                k.poisson_uv, k.poisson_vu);
             if (!k.note.empty()) ImGui::TextWrapped("%s", k.note.c_str());
         } catch (const SceneError& e) {
             ImGui::TextWrapped("%s", e.what());
@@ -464,7 +469,7 @@ void help_section() {
 
 float panel_width(const AppState& app, float content_scale, float window_width) {
     if (!app.show_panel) return 0.0f;
-    return std::min(kPanelWidth * content_scale, kMaxPanelShare * window_width);
+    return std::min(app.panel_width * content_scale, kMaxPanelShare * window_width);
 }
 
 namespace {
@@ -556,25 +561,17 @@ void scene_section(AppState& app, PanelRequests& requests) {
     }
 }
 
-// The forces' fields, and the wind as strength and heading, as a user thinks of it (both edit forces.wind).
+// The forces' fields; the wind's speed and heading beneath its vector, read from it.
 void forces_section(Scene& edit, AppState& app) {
     fields_section(edit, app, "forces.");
-    glm::vec3& wind = edit.settings.forces.wind;
-    float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
-    const float old_speed = speed;
-    if (ImGui::SliderFloat("wind speed", &speed, 0.0f, 50.0f, "%.2f m/s")) {
-        wind = old_speed > 0.0f ? wind * (speed / old_speed) : glm::vec3(speed, 0.0f, 0.0f);
-        keep_in_range(app, edit, *find_field("forces.wind"));  // a typed speed obeys forces.wind's range
+    const glm::vec3 wind = edit.settings.forces.wind;
+    const float speed = std::sqrt(wind.x * wind.x + wind.y * wind.y + wind.z * wind.z);
+    if (speed > 0.0f) {
+        ImGui::TextDisabled("wind %.3g m/s, heading %.0f deg from +x toward +z", speed,
+                            std::atan2(wind.z, wind.x) * 57.29578f);
+    } else {
+        ImGui::TextDisabled("no wind");
     }
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("|forces.wind| in m/s; keeps the direction");
-    float heading = std::atan2(wind.z, wind.x) * 57.29578f;
-    if (speed > 0.0f && ImGui::SliderFloat("wind heading", &heading, -180.0f, 180.0f, "%.0f deg")) {
-        const float horizontal = std::sqrt(wind.x * wind.x + wind.z * wind.z);
-        wind.x = horizontal * std::cos(heading / 57.29578f);
-        wind.z = horizontal * std::sin(heading / 57.29578f);
-        keep_in_range(app, edit, *find_field("forces.wind"));
-    }
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("direction in the ground plane, degrees from +x toward +z");
 }
 
 // The stability limit, where the current substep stands against it, and the auto choice (the stepper's).
@@ -594,9 +591,10 @@ void stability_lines(AppState& app) {
     const StabilityLimit& limit = app.stepper.limit(app.sim);
     const IntegrationSettings& integration = app.sim.settings().integration;
     const double substep = app.sim.substep_length();
-    if (limit.unconditionally_stable) {
+    if (limit.unconditionally_stable) {  // two lines, as below: nothing moves when the integrator changes
         ImGui::TextColored(ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "no explicit step limit (%s)",
                            std::string(integrator_names()[static_cast<int>(integration.integrator)]).c_str());
+        ImGui::Text("substep %.4g ms%s", 1e3 * substep, auto_substeps ? " (auto)" : "");
         return;
     }
     const double fraction = substep / limit.critical_substep;
@@ -620,9 +618,14 @@ void integration_section(Scene& edit, AppState& app) {
     stability_lines(app);
     fields_section(edit, app, "integration.");
     fields_section(edit, app, "solver.");
-    int catchup = app.stepper.policy().max_catchup_steps;
-    if (ImGui::SliderInt("max catch-up steps", &catchup, 1, 16, "%d", ImGuiSliderFlags_AlwaysClamp)) app.stepper.set_max_catchup_steps(catchup);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("steps per frame at most; slower frames slow the simulation down");
+    float budget_ms = static_cast<float>(1e3 * app.stepper.policy().frame_budget);
+    if (ImGui::SliderFloat("frame budget (ms)", &budget_ms, 5.0f, 200.0f, "%.0f", ImGuiSliderFlags_AlwaysClamp)) {
+        app.stepper.set_frame_budget(1e-3 * budget_ms);
+    }
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("wall time a frame spends on physics before it starts no further step (one step always\n"
+                          "runs); a simulation that needs more runs slower than real time instead of freezing the app");
+    }
 }
 
 void colliders_section(Scene& edit, AppState& app) {
@@ -686,9 +689,12 @@ void view_section(AppState& app, PanelRequests& requests) {
 
 void stats_section(const AppState& app) {
     const ImGuiIO& io = ImGui::GetIO();
-    ImGui::Text("%.0f FPS (%.2f ms per frame)", io.Framerate, 1000.0f / std::max(io.Framerate, 1e-3f));
-    ImGui::Text("simulation %.2f ms (%lld substeps), render %.2f ms", app.stats.sim_ms, app.stats.substeps_last_frame,
-                app.stats.render_ms);
+    // This frame's wall time, in parts that add up: the physics, the drawing, and the rest (the buffer swap,
+    // vsync's wait, input).
+    const Stats& st = app.stats;
+    ImGui::Text("%.0f FPS; frame %.1f ms = simulation %.1f + render %.1f + swap and wait %.1f", io.Framerate,
+                st.frame_ms, st.sim_ms, st.render_ms, std::max(st.frame_ms - st.sim_ms - st.render_ms, 0.0f));
+    ImGui::TextDisabled("%lld substeps this frame", st.substeps_last_frame);
     if (app.sim.broken_springs() > 0) {  // torn or cut: as --json's broken_springs
         ImGui::Text("%zu particles, %zu springs (%zu broken), t = %.2f s", app.sim.particle_count(),
                     app.sim.spring_count(), app.sim.broken_springs(), app.sim.time());
@@ -708,9 +714,16 @@ void stats_section(const AppState& app) {
     } else {
         ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);
     }
-    if (app.stats.dropped_seconds > 0.0) {
-        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2f s of simulated time skipped",
-                           app.stats.dropped_seconds);
+    // Said only while the simulation cannot keep up with the time scale; a line kept in place (blank when it
+    // keeps up) so nothing below it moves.
+    if (!app.paused && app.stats.speed < 0.9f * app.time_scale) {
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2fx real time, not %.2fx (%s)",
+                           app.stats.speed, app.time_scale,
+                           app.stats.sim_ms > 1e3 * app.stepper.policy().frame_budget
+                               ? "a step takes longer than the frame budget"
+                               : "the frames are too slow");
+    } else {
+        ImGui::TextUnformatted("");
     }
     // Accuracy hint: how much total energy moved over the plotted window. With no damping, no wind and no
     // contact it should stay put, and its drift measures the integrator's error at this step.
@@ -754,15 +767,22 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     PanelRequests requests;
     const ImGuiViewport* viewport = ImGui::GetMainViewport();
     ImGui::SetNextWindowPos(viewport->WorkPos, ImGuiCond_Always);
+    // The width is the user's: a drag of the panel's right edge sets it (kept while the app runs), within
+    // kMinPanelWidth and kMaxPanelShare of the window.
+    const float max_width = std::max(kMaxPanelShare * viewport->WorkSize.x, kMinPanelWidth * content_scale);
     ImGui::SetNextWindowSize(ImVec2(panel_width(app, content_scale, viewport->WorkSize.x), viewport->WorkSize.y),
                              ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanelWidth * content_scale, viewport->WorkSize.y),
+                                        ImVec2(max_width, viewport->WorkSize.y));
     ImGui::SetNextWindowBgAlpha(0.92f);
-    ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse);
+    app.panel_width = ImGui::GetWindowWidth() / content_scale;
     // The settings scroll; the message area below them keeps its height, so nothing moves under the mouse.
     const float message_height = 5.5f * ImGui::GetTextLineHeightWithSpacing();
     ImGui::BeginChild("settings", ImVec2(0.0f, -(message_height + ImGui::GetFrameHeightWithSpacing() +
                                                 ImGui::GetStyle().ItemSpacing.y)));
-    ImGui::PushItemWidth(-ImGui::GetFontSize() * 8.5f);
+    // The labels' column: the longest label with its unit ("self friction (N/m)") and the reset button.
+    ImGui::PushItemWidth(-ImGui::GetFontSize() * 14.0f);
     // The widgets edit a copy of the running scene. A settings change reaches the simulation through its one
     // call (MassSpring::apply); a cloth or pin change asks for a rebuild from the edited copy, which becomes
     // the document only when it builds.

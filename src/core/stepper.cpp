@@ -1,6 +1,8 @@
 #include "clothsim/stepper.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 namespace clothsim {
 
@@ -30,20 +32,32 @@ int Stepper::choose_substeps(MassSpring& sim) {
 }
 
 StepReport Stepper::advance(MassSpring& sim, double seconds) {
-    choose_substeps(sim);
-    const double dt = sim.settings().integration.dt;
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
     accumulator_ += seconds;
-    long long steps = static_cast<long long>(accumulator_ / dt);
-    double dropped = 0.0;
-    if (steps > policy_.max_catchup_steps) {
-        dropped = static_cast<double>(steps - policy_.max_catchup_steps) * dt;
-        steps = policy_.max_catchup_steps;
-        accumulator_ = 0.0;
-    } else {
-        accumulator_ -= static_cast<double>(steps) * dt;
+    StepReport report;
+    for (;;) {
+        choose_substeps(sim);
+        const double dt = sim.settings().integration.dt;
+        if (accumulator_ < dt) break;
+        if (report.steps > 0 && std::chrono::duration<double>(Clock::now() - start).count() >= policy_.frame_budget) {
+            // Over budget with whole steps still owed: they are dropped, the fraction of a step is kept.
+            const double owed = std::floor(accumulator_ / dt) * dt;
+            report.dropped_seconds = owed;
+            accumulator_ -= owed;
+            break;
+        }
+        const StepReport one = run(sim, 1);
+        accumulator_ -= dt;
+        report.steps += one.steps;
+        report.guard_log += one.guard_log;
+        report.guard_gave_up = one.guard_gave_up;
+        report.skipped_non_finite = one.skipped_non_finite;
+        if (one.steps == 0 || one.guard_gave_up) {  // nothing more to step this frame: owe nothing
+            accumulator_ = 0.0;
+            break;
+        }
     }
-    StepReport report = run(sim, steps);
-    report.dropped_seconds = dropped;
     return report;
 }
 

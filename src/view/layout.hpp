@@ -9,7 +9,8 @@
 
 namespace clothsim {
 
-inline constexpr float kPanelWidth = 360.0f;  // window coordinates at content scale 1
+inline constexpr float kPanelWidth = 440.0f;  // window coordinates at content scale 1: the panel's starting width
+inline constexpr float kMinPanelWidth = 300.0f;  // ... and the narrowest a drag of its edge makes it
 inline constexpr float kMaxPanelShare = 0.45f;  // of the window's width: a narrow window keeps a 3D view
 
 // The 3D view (x, y from the top-left, width, height) in window coordinates.

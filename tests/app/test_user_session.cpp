@@ -13,6 +13,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -328,11 +329,11 @@ TEST_CASE("user session: a slit cut up into the paused curtain shows as a seam, 
 
 TEST_CASE("user session: typed out-of-range values are clamped with a note, and Save writes a file Open accepts") {
     const TempDir dir("session_typed");
-    // Forces open; wind speed typed 1e9 (allowed |wind| components up to 1e4), damping typed 1e9.
+    // Forces open; the wind's x typed 1e9 (allowed components up to 1e4), damping typed 1e9.
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
-                                         "click 50 381\n"
-                                         "ctrl_click 117 565\nkey ctrl+a\ntype 1e9\nkey Return\n"
-                                         "ctrl_click 117 289\nkey ctrl+a\ntype 1e9\nkey Return\n"
+                                         "click 50 465\n"
+                                         "ctrl_click 40 511\nkey ctrl+a\ntype 1e9\nkey Return\n"
+                                         "ctrl_click 117 373\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "click 65 151\nsettle\nquit\n",
                                          zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);
@@ -389,7 +390,7 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
     // Springs' damping typed 0.5 (curtain has 0.3): the title gains its mark; saved, it loses it.
     const RunResult first = run_user_session(dir, {"--scene", "curtain", "--paused"},
                                              "echo \"title start: $(xdotool getwindowname $wid)\"\n"
-                                             "ctrl_click 117 289\nkey ctrl+a\ntype 0.5\nkey Return\n"
+                                             "ctrl_click 117 373\nkey ctrl+a\ntype 0.5\nkey Return\n"
                                              "echo \"title edited: $(xdotool getwindowname $wid)\"\n"
                                              "click 65 151\nsettle\n"
                                              "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n",
@@ -474,4 +475,120 @@ TEST_CASE("user session: while the desktop's dialog is open, Escape and drops ar
     REQUIRE(r.code == 0);
     CHECK_THAT(r.out, Contains("title: clothsim - curtain\n"));  // Escape did not quit; the dialog's answer opened
     CHECK_THAT(r.err, Contains("dropped files not opened: a file dialog is open"));
+}
+
+// ---- Live tuning (the panel as of the fabric controls): the Springs section's rows in a 1280 x 720 window. ----
+namespace {
+constexpr const char* kStretchWarp = "60 266";   // material.stretch, first component
+constexpr const char* kStretchWeft = "165 266";  // ... second
+constexpr const char* kDamping = "117 373";      // springs.damping
+constexpr const char* kDampingReset = "360 373"; // its `reset` button, right of "damping (1/s)", once changed
+constexpr const char* kSave = "65 151";          // "Save scene as..."
+}  // namespace
+
+TEST_CASE("user session: stretch typed live on a running cloth, confirmed by a quick Enter tap, is saved without a rebuild") {
+    const TempDir dir("session_live_stretch");
+    // Typed 10x and then 0.1x of hanging's 1200 N/m, each ended by a tap of Return (press and release sent
+    // together, as a quick finger at a low frame rate does: both land between two frames).
+    const RunResult r = run_user_session(
+        dir, {"--scene", "hanging"},
+        std::string("settle\n") + "ctrl_click " + kStretchWarp + "\nkey ctrl+a\ntype 12000\nxdotool key Return\nsettle\n" +
+            "ctrl_click " + kStretchWeft + "\nkey ctrl+a\ntype 120\nxdotool key Return\nsettle\nshot live.png\n" +
+            "click " + kSave + "\nsettle\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, !Contains("rebuil") && !Contains("guard") && !Contains("fabric not changed"));
+    const fs::path saved = dir / "hanging-edited.toml";
+    REQUIRE(fs::exists(saved));
+    const clothsim::Scene reopened = clothsim::load_scene(saved.string());
+    CHECK(reopened.material.stretch == glm::vec2(12000.0f, 120.0f));
+    // The running cloth took them: the springs saved (derived on this grid) follow the typed stretch.
+    const clothsim::Scene loaded = clothsim::load_scene("hanging");
+    CHECK(reopened.material.density == loaded.material.density);
+}
+
+TEST_CASE("user session: the reset button and the right-click menu bring a dragged field back to the scene's value") {
+    const TempDir dir("session_reset_field");
+    // Damping dragged from 0.2 toward the right end (the title gains its mark); the right-click menu's first
+    // item ("Reset to scene value", opened where the mouse is) brings it back; dragged again, the small
+    // `reset` button right of its label does too; saved: the scene's 0.2.
+    auto title = [](const std::string& when) {
+        return "echo \"title " + when + ": $(xdotool getwindowname $wid)\"\n";
+    };
+    const RunResult r = run_user_session(
+        dir, {"--scene", "hanging"},
+        std::string("drag ") + kDamping + " 200 373\n" + title("dragged") + "at 117 373\nxdotool click 3\nsettle\n" +
+            "click 150 385\nsettle\n" + title("menu") + "drag " + kDamping + " 200 373\n" + title("dragged again") +
+            "click " + kDampingReset + "\nsettle\n" + title("button") + "click " + kSave + "\nsettle\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("title dragged: clothsim - hanging*\n") && Contains("title menu: clothsim - hanging\n") &&
+                          Contains("title dragged again: clothsim - hanging*\n") &&
+                          Contains("title button: clothsim - hanging\n"));
+    const fs::path saved = dir / "hanging-edited.toml";
+    REQUIRE(fs::exists(saved));
+    CHECK(clothsim::load_scene(saved.string()).settings.springs.damping == 0.2f);
+}
+
+TEST_CASE("user session: R keeps a pin placed by hand, and Revert drops it") {
+    const clothsim::Scene scene = clothsim::load_scene("hanging");
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const glm::vec3 at = particle_on_screen(scene, middle);
+    const TempDir dir("session_reset_keeps_pins");
+    const RunResult r = run_user_session(
+        dir, {"--scene", "hanging", "--paused"},
+        "ctrl_click " + at_xy(at) + "\nat 900 600\nkey r\nsettle\nshot reset.png\nclick " + kSave + "\nsettle\n" +
+            "echo \"title after reset: $(xdotool getwindowname $wid)\"\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const fs::path saved = dir / "hanging-edited.toml";
+    REQUIRE(fs::exists(saved));
+    const clothsim::Scene reopened = clothsim::load_scene(saved.string());
+    // hanging starts flat and edge-on: the click pins the particle of that column nearest the camera. The
+    // scene's two corner pins are saved as explicit ones, with the hand-placed pin beside them.
+    const bool kept = reopened.pins.particles.size() == pinned_particles(scene).size() + 1;
+    CHECK(kept);
+    CHECK(red_near(load_png(dir / "reset.png"), at, 3));  // drawn as a pin after R
+
+    const TempDir revert_dir("session_revert_drops_pins");
+    const RunResult reverted = run_user_session(
+        revert_dir, {"--scene", "hanging", "--paused"},
+        "ctrl_click " + at_xy(at) + "\nclick 283 105\nsettle\nat 900 600\nsettle\n" +
+            "echo \"title: $(xdotool getwindowname $wid)\"\nshot reverted.png\nquit\n");
+    CAPTURE_RUN(reverted);
+    REQUIRE(reverted.code == 0);
+    CHECK_THAT(reverted.out, Contains("title: clothsim - hanging\n"));  // no edit left
+    CHECK_FALSE(red_near(load_png(revert_dir / "reverted.png"), at, 3));
+}
+
+TEST_CASE("user session: each pin of hanging and curtain dragged 300 px in half a second: no guard, no pause") {
+    for (const char* name : {"hanging", "curtain"}) {
+        const clothsim::Scene scene = clothsim::load_scene(name);
+        const std::vector<std::size_t> pins = pinned_particles(scene);
+        REQUIRE(!pins.empty());
+        // curtain pins its whole top row: its two ends and its middle stand for the rest.
+        std::vector<std::size_t> dragged = pins.size() <= 4 ? pins : std::vector<std::size_t>{pins.front(), pins[pins.size() / 2], pins.back()};
+        std::string actions = "settle\n";
+        for (std::size_t pin : dragged) {
+            const glm::vec3 p = particle_on_screen(scene, pin);
+            // Ten moves of 30 px (down and right) 50 ms apart, the button held; then back where it came from.
+            actions += "at " + at_xy(p) + "\nxdotool mousedown 1\n";
+            for (int k = 1; k <= 10; ++k) {
+                actions += "xdotool mousemove --window $wid " + std::to_string(int(p.x) + 21 * k) + " " +
+                           std::to_string(int(p.y) + 21 * k) + "; sleep 0.05\n";
+            }
+            actions += "xdotool mouseup 1\nsettle\nkey r\n";
+        }
+        actions += "settle\necho \"title: $(xdotool getwindowname $wid)\"\nquit\n";
+        INFO(name);
+        const TempDir dir(std::string("session_pin_drag_") + name);
+        const RunResult r = run_user_session(dir, {"--scene", name}, actions);
+        CAPTURE_RUN(r);
+        CHECK(r.code == 0);
+        CHECK_THAT(r.err, !Contains("guard") && !Contains("strain") && !Contains("failed") && !Contains("paused"));
+    }
 }

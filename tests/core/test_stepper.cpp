@@ -1,4 +1,4 @@
-// The Stepper: the run policy the app and --headless share (fixed step, catch-up cap, auto substeps, the
+// The Stepper: the run policy the app and --headless share (fixed step, frame budget, auto substeps, the
 // guard), and results bit-identical to recorded runs.
 #include "clothsim/scene.hpp"
 #include "clothsim/stepper.hpp"
@@ -127,7 +127,9 @@ TEST_CASE("stepper every bundled scene runs bit-identically to the recorded posi
 
 TEST_CASE("stepper advance runs whole steps of dt and carries the remainder", "[stepper]") {
     MassSpring sim = hanging(0.01f);
-    Stepper stepper;
+    RunPolicy policy;
+    policy.frame_budget = 1e9;  // every step owed runs, however loaded the machine
+    Stepper stepper(policy);
     CHECK(stepper.advance(sim, 0.025).steps == 2);  // 5 ms carried
     CHECK(stepper.advance(sim, 0.004).steps == 0);  // 9 ms
     CHECK(stepper.advance(sim, 0.002).steps == 1);  // 11 ms: one step, 1 ms left
@@ -136,16 +138,25 @@ TEST_CASE("stepper advance runs whole steps of dt and carries the remainder", "[
     CHECK(stepper.advance(sim, 0.0095).steps == 0);  // the 1 ms was forgotten
 }
 
-TEST_CASE("stepper advance caps the catch-up and says how much time it dropped", "[stepper]") {
+TEST_CASE("stepper advance stops starting steps once its frame budget of wall time is spent, and says how much "
+          "time it dropped",
+          "[stepper]") {
     MassSpring sim = hanging(0.01f);
     RunPolicy policy;
-    policy.max_catchup_steps = 4;
+    policy.frame_budget = 0.0;  // spent by the first step: one step a frame, whatever it costs
     Stepper stepper(policy);
-    const StepReport report = stepper.advance(sim, 0.105);  // 10 steps owed
-    CHECK(report.steps == 4);
-    CHECK(report.dropped_seconds == Approx(0.06).margin(1e-9));
-    CHECK(sim.time() == Approx(0.04).margin(1e-5));
-    CHECK(stepper.advance(sim, 0.0).steps == 0);  // nothing carried past a capped frame
+    const StepReport report = stepper.advance(sim, 0.105);  // 10 steps owed (and 5 ms)
+    CHECK(report.steps == 1);
+    CHECK(report.dropped_seconds == Approx(0.09).margin(1e-9));
+    CHECK(sim.time() == Approx(0.01).margin(1e-5));
+    CHECK(stepper.advance(sim, 0.0).steps == 0);  // the whole steps were dropped; 5 ms stays owed
+    CHECK(stepper.advance(sim, 0.005).steps == 1);
+
+    stepper.set_frame_budget(1e9);  // no budget to speak of: every step owed runs
+    const StepReport all = stepper.advance(sim, 0.1);
+    CHECK(all.steps == 10);
+    CHECK(all.dropped_seconds == 0.0);
+    CHECK(sim.time() == Approx(0.12).margin(1e-5));
 }
 
 TEST_CASE("stepper auto substeps follows a stiffness change and keeps the substep at the safety fraction",

@@ -4,6 +4,7 @@
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
 #include "fma_peak.hpp"
+#include "realtime.hpp"
 #include "skipping.hpp"
 #include "stability_sweep.hpp"
 #include "stiff_precision.hpp"
@@ -183,6 +184,13 @@ int main(int argc, char** argv) {
     skipping->add_option("--csv", sk.csv, "Write the table as CSV");
     skipping->add_option("--self-threads", sk.self_threads, "solver.threads of the self-collision cases (0: the scene's)")
         ->check(CLI::Range(0, 64));
+    bench::RealtimeOptions rt;
+    CLI::App* realtime = app.add_subcommand(
+        "realtime", "Wall seconds per simulated second of every bundled scene as the app steps it (README)");
+    realtime->add_option("--T", rt.duration, "Simulated seconds per run")->check(CLI::PositiveNumber);
+    realtime->add_option("--threads", rt.threads, "solver.threads of the runs")->delimiter(',');
+    realtime->add_option("--repeats", rt.repeats, "Interleaved runs per case (median)")->check(CLI::Range(1, 50));
+    realtime->add_option("--csv", rt.csv, "Write the table as CSV");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -198,6 +206,7 @@ int main(int argc, char** argv) {
     if (*stability) return bench::run_stability(st);
     if (*substep_sweep) return bench::run_substep_sweep(ss);
     if (*skipping) return bench::run_skipping(sk);
+    if (*realtime) return bench::run_realtime(rt);
 
     std::vector<Row> rows;
     try {

@@ -166,12 +166,15 @@ public:
     // Moves a pinned particle to `position` (a grab, a moving anchor); it carries no velocity of its own, its
     // springs pull on its neighbours from the new place at the next step. Does nothing to a free particle.
     void move_pinned(std::size_t i, glm::vec3 position);
-    // A user's drag of pinned particle `i` toward `target`: each substep moves the pin by at most
-    // kPinStepPerSubstep of the cloth's particle spacing toward it, the speed an explicit solver follows (the
-    // Courant-Friedrichs-Lewy condition: a disturbance crosses at most one spacing per substep), so a
-    // drag never stretches the pin's springs by more than that in one substep, whatever the frame rate. The
-    // pin keeps going until it reaches the target; calling again moves the target. Wakes the cloth. Does
-    // nothing to a free particle; freeing the pin drops its target.
+    // A user's drag of pinned particle `i` toward `target`: the pin travels there at a steady speed over the
+    // next step (the mouse's speed: the distance over integration.dt), a part of it each substep, and never
+    // faster than kPinStepPerSubstep of the cloth's particle spacing per substep, the speed an explicit solver
+    // follows (the Courant-Friedrichs-Lewy condition: a disturbance crosses at most one spacing per substep).
+    // So a drag moves the pin smoothly whatever the frame rate, instead of one jump a frame. While tethers
+    // act (springs.tether_strain > 0) the pin goes no farther from any other pin than (1 + tether_strain)
+    // times their rest distance: the cloth between them does not reach farther, and the tethers could not all
+    // hold. The pin keeps going until it reaches the target (or that limit); calling again moves the target.
+    // Wakes the cloth. Does nothing to a free particle; freeing the pin drops its target.
     void drag_pin(std::size_t i, glm::vec3 target);
     static constexpr double kPinStepPerSubstep = 0.25;
     // Where a dragged pin is heading (nothing when it is not dragged or has arrived).
@@ -240,6 +243,8 @@ private:
     float grab_force_limit(std::size_t i) const;
     // The first stage of a substep: dragged pins step toward their targets (drag_pin). Returns whether any moved.
     bool move_dragged_pins();
+    // Where pin i may go on its way to `x` while tethers act (drag_pin).
+    glm::dvec3 within_tether_reach(std::size_t i, glm::dvec3 from, glm::dvec3 x) const;
 
     // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
     struct FastSolverHolder {
@@ -312,6 +317,7 @@ private:
     struct PinTarget {
         std::size_t particle = 0;
         glm::dvec3 target{0.0};  // m
+        double reach = 0.0;      // m per substep
     };
     std::vector<PinTarget> pin_targets_;  // pins dragged toward a target (drag_pin), at most a few
     Vec3Array grab_external_;    // N: the grab's and soft clips' forces (zero elsewhere), for the fast solver

@@ -75,8 +75,8 @@ StepCheck check_step(const MassSpring& sim, double energy_before, const GuardSet
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log);
 
 // The largest |d| / L0 - 1 over springs with L0 > 0 (NaN-safe: a non-finite spring counts as infinite),
-// leaving out the springs of a grabbed particle (a strain the user imposes is not a blow-up) and springs of
-// a kind with stiffness 0 (they exert no force).
+// leaving out the springs of a grabbed particle and those between two pins (a strain the user imposes, by a
+// grab or by dragging a pin, is not a blow-up) and springs of a kind with stiffness 0 (they exert no force).
 double max_strain(const MassSpring& sim);
 
 }  // namespace clothsim

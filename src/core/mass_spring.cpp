@@ -782,6 +782,7 @@ void MassSpring::set_pinned(std::size_t i, bool pinned) {
     setup_stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
+    if (!pinned) std::erase_if(pin_targets_, [&](const PinTarget& t) { return t.particle == i; });
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
     iterative_.invalidate();  // its matrix is over the free particles
     rebuild_tethers();  // the pins the cloth hangs from changed
@@ -799,13 +800,18 @@ void MassSpring::move_pinned(std::size_t i, glm::vec3 position) {
 void MassSpring::drag_pin(std::size_t i, glm::vec3 target) {
     if (state_.pinned.at(i) != kPinned) return;
     wake();
+    const glm::dvec3 to(target);
+    // The whole way in one step of integration.dt, at most kPinStepPerSubstep spacings a substep.
+    const double way = glm::length(to - state_.position.get(i));
+    const double reach = std::min(way / std::max(settings_.integration.substeps, 1), kPinStepPerSubstep * spacing_);
     for (PinTarget& t : pin_targets_) {
         if (t.particle == i) {
-            t.target = glm::dvec3(target);
+            t.target = to;
+            t.reach = reach;
             return;
         }
     }
-    pin_targets_.push_back({i, glm::dvec3(target)});
+    pin_targets_.push_back({i, to, reach});
 }
 
 std::optional<glm::vec3> MassSpring::pin_target(std::size_t i) const {
@@ -816,23 +822,46 @@ std::optional<glm::vec3> MassSpring::pin_target(std::size_t i) const {
 }
 
 bool MassSpring::move_dragged_pins() {
-    const double reach = kPinStepPerSubstep * spacing_;
     bool moved = false;
     std::erase_if(pin_targets_, [&](const PinTarget& t) {
-        if (state_.pinned[t.particle] != kPinned) return true;  // freed since
         const glm::dvec3 x = state_.position.get(t.particle);
         const glm::dvec3 d = t.target - x;
         const double length = glm::length(d);
-        if (!(length > reach)) {  // arrives this substep (a NaN target is dropped where the pin is)
-            if (std::isfinite(length)) state_.position.set(t.particle, t.target);
-            moved = moved || length > 0.0;
-            return true;
-        }
-        state_.position.set(t.particle, x + d * (reach / length));
-        moved = true;
-        return false;
+        if (!std::isfinite(length)) return true;  // a NaN target is dropped where the pin is
+        const bool arrives = !(length > t.reach * (1.0 + 1e-9));
+        glm::dvec3 to = arrives ? t.target : x + d * (t.reach / length);
+        if (plan_.tethers) to = within_tether_reach(t.particle, x, to);
+        const double step = glm::length(to - x);
+        moved = moved || step > 0.0;
+        state_.position.set(t.particle, to);
+        return arrives || !(step > 1e-6 * t.reach);  // arrived, or held at the tethers' reach
     });
     return moved;
+}
+
+// Cyclic projection onto the balls around the other pins (radius (1 + tether_strain) x the rest distance):
+// their intersection is convex and holds `from`, where the pin is, so a few rounds land in it or near; a
+// point still outside any ball (by more than rounding) leaves the pin where it is.
+glm::dvec3 MassSpring::within_tether_reach(std::size_t i, glm::dvec3 from, glm::dvec3 x) const {
+    const double stretch = 1.0 + double(settings_.springs.tether_strain);
+    const glm::dvec3 rest = rest_position_.get(i);
+    auto outside = [&](std::size_t j, glm::dvec3 p) {
+        return glm::length(p - state_.position.get(j)) > stretch * glm::length(rest - rest_position_.get(j)) * (1.0 + 1e-9);
+    };
+    for (int round = 0; round < 4; ++round) {
+        bool moved = false;
+        for (std::size_t j = 0; j < state_.size(); ++j) {
+            if (j == i || state_.pinned[j] != kPinned || !outside(j, x)) continue;
+            const glm::dvec3 pin = state_.position.get(j);
+            x = pin + (x - pin) * (stretch * glm::length(rest - rest_position_.get(j)) / glm::length(x - pin));
+            moved = true;
+        }
+        if (!moved) return x;
+    }
+    for (std::size_t j = 0; j < state_.size(); ++j) {
+        if (j != i && state_.pinned[j] == kPinned && outside(j, x)) return from;
+    }
+    return x;
 }
 
 void MassSpring::set_particle(std::size_t i, glm::vec3 position, glm::vec3 velocity) {

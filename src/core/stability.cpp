@@ -159,6 +159,8 @@ double max_strain(const MassSpring& sim) {
     for (const Spring& s : sim.topology().springs) {
         if (s.rest_length == 0.0f) continue;
         if (grabbed && (s.a == *grabbed || s.b == *grabbed)) continue;  // the user's pull, not a blow-up
+        // Between two pins: its length is where the user put the pins (a dragged pin), never the dynamics'.
+        if (sim.state().pinned[s.a] == kPinned && sim.state().pinned[s.b] == kPinned) continue;
         if (stiffness_of(sim.settings().springs, s) == 0.0f) continue;  // exerts no force: not a spring
         const double length = glm::length(glm::dvec3(sim.position(s.b)) - glm::dvec3(sim.position(s.a)));
         if (!std::isfinite(length)) return std::numeric_limits<double>::infinity();

@@ -334,7 +334,7 @@ TEST_CASE("user session: typed out-of-range values are clamped with a note, and 
                                          "click 50 465\n"
                                          "ctrl_click 40 511\nkey ctrl+a\ntype 1e9\nkey Return\n"
                                          "ctrl_click 117 373\nkey ctrl+a\ntype 1e9\nkey Return\n"
-                                         "click 65 151\nsettle\nquit\n",
+                                         "click 65 151\nwait_for flag-edited.toml\nquit\n",
                                          zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
@@ -392,7 +392,7 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
                                              "echo \"title start: $(xdotool getwindowname $wid)\"\n"
                                              "ctrl_click 117 373\nkey ctrl+a\ntype 0.5\nkey Return\n"
                                              "echo \"title edited: $(xdotool getwindowname $wid)\"\n"
-                                             "click 65 151\nsettle\n"
+                                             "click 65 151\nwait_for curtain-edited.toml\n"
                                              "echo \"title saved: $(xdotool getwindowname $wid)\"\nquit\n",
                                              zenity_saving_as_proposed(dir));
     CAPTURE_RUN(first);
@@ -462,14 +462,16 @@ TEST_CASE("user session: a .toml dropped onto the window opens, other dropped fi
 }
 
 TEST_CASE("user session: while the desktop's dialog is open, Escape and drops are not the app's, and it keeps running") {
-    // A stand-in zenity that takes 3 s to answer, as a user browsing would.
+    // A stand-in zenity that answers when the session says so (it creates `answer`), as a user browsing would.
     const TempDir dir("session_dialog_open");
-    const std::string env = stand_in_zenity(dir, "sleep 3\necho " + quote(scene_path("curtain")));
+    const std::string env = stand_in_zenity(
+        dir, "while [ ! -e " + quote((dir / "answer").string()) + " ]; do sleep 0.05; done\necho " + quote(scene_path("curtain")));
     const fs::path dropped = dir / "dropped.toml";
     fs::copy_file(scene_path("drape-sphere"), dropped);
     const RunResult r = run_user_session(dir, {"--scene", "flag"},
                                          "click 50 82\nkey Escape\ndrop 900 400 " + quote(dropped.string()) +
-                                             "\nsleep 3\necho \"title: $(xdotool getwindowname $wid)\"\nquit\n",
+                                             "\ntouch answer\ntitle_has curtain\n"
+                                             "echo \"title: $(xdotool getwindowname $wid)\"\nquit\n",
                                          env);
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
@@ -494,7 +496,7 @@ TEST_CASE("user session: stretch typed live on a running cloth, confirmed by a q
         dir, {"--scene", "hanging"},
         std::string("settle\n") + "ctrl_click " + kStretchWarp + "\nkey ctrl+a\ntype 12000\nxdotool key Return\nsettle\n" +
             "ctrl_click " + kStretchWeft + "\nkey ctrl+a\ntype 120\nxdotool key Return\nsettle\nshot live.png\n" +
-            "click " + kSave + "\nsettle\nquit\n",
+            "click " + kSave + "\nwait_for hanging-edited.toml\nquit\n",
         zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
@@ -520,7 +522,7 @@ TEST_CASE("user session: the reset button and the right-click menu bring a dragg
         dir, {"--scene", "hanging"},
         std::string("drag ") + kDamping + " 200 373\n" + title("dragged") + "at 117 373\nxdotool click 3\nsettle\n" +
             "click 150 385\nsettle\n" + title("menu") + "drag " + kDamping + " 200 373\n" + title("dragged again") +
-            "click " + kDampingReset + "\nsettle\n" + title("button") + "click " + kSave + "\nsettle\nquit\n",
+            "click " + kDampingReset + "\nsettle\n" + title("button") + "click " + kSave + "\nwait_for hanging-edited.toml\nquit\n",
         zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
@@ -540,7 +542,7 @@ TEST_CASE("user session: R keeps a pin placed by hand, and Revert drops it") {
     const TempDir dir("session_reset_keeps_pins");
     const RunResult r = run_user_session(
         dir, {"--scene", "hanging", "--paused"},
-        "ctrl_click " + at_xy(at) + "\nat 900 600\nkey r\nsettle\nshot reset.png\nclick " + kSave + "\nsettle\n" +
+        "ctrl_click " + at_xy(at) + "\nat 900 600\nkey r\nsettle\nshot reset.png\nclick " + kSave + "\nwait_for hanging-edited.toml\n" +
             "echo \"title after reset: $(xdotool getwindowname $wid)\"\nquit\n",
         zenity_saving_as_proposed(dir));
     CAPTURE_RUN(r);

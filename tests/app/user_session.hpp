@@ -21,14 +21,26 @@ namespace clothsim::test {
 //   drag X0 Y0 X1 Y1     left button down at (X0, Y0), moved to (X1, Y1), released
 //   cut X0 Y0 X1 Y1      the same with the right button and Shift held (the knife)
 //   shot NAME            an F12 screenshot, saved as NAME (a PNG in the session's directory)
-//   settle               waits for a few frames to be drawn
-//   title_has TEXT       waits (up to 15 s) until the window's title contains TEXT: an action whose effect
+//   settle               waits until the app has drawn two frames after what came before (frame, twice)
+//   frame                waits until the app has drawn a frame after what came before: F12 asks for a
+//                        screenshot, which the app writes at the end of the frame that read the key, so the
+//                        file's arrival is that frame (up to 60 s on a loaded machine); the file is removed
+//   wait_for FILE        waits (up to 60 s) until FILE exists in the session's directory (a save)
+//   title_has TEXT       waits (up to 60 s) until the window's title contains TEXT: an action whose effect
 //                        takes longer than a few frames under load (a file opened through the dialog)
 //   drop X Y FILE...     drops files at (X, Y) as a file manager does (XDND, tests/app/xdnd_drop.cpp)
 //   quit                 presses Escape (the app's quit key) with the pointer over the 3D view
-// Each action waits long enough afterwards for the app to have drawn frames with it (also in the ASan build).
+// Each action waits afterwards until the app has drawn frames with it: it waits for the frames, never for a
+// fixed time, so a session passes on a loaded machine and in the ASan build alike.
 inline const char* kSessionFunctions = R"sh(
-settle() { sleep 0.8; }
+frame() {
+  rm -f clothsim-*.png
+  xdotool keydown F12; sleep 0.02; xdotool keyup F12
+  for _ in $(seq 600); do ls clothsim-*.png >/dev/null 2>&1 && break; kill -0 $app 2>/dev/null || break; sleep 0.05; done
+  rm -f clothsim-*.png
+}
+settle() { frame; frame; }
+wait_for() { for _ in $(seq 600); do [ -e "$1" ] && break; sleep 0.1; done; settle; }
 # Held for 0.15 s as a hand holds a key: ImGui 1.86's widgets see the key state once a frame, so a press and
 # release within one slow frame (xdotool's plain "key") would never reach a text field.
 key() { for k in "$@"; do xdotool keydown "$k"; sleep 0.15; xdotool keyup "$k"; sleep 0.05; done; settle; }
@@ -41,14 +53,18 @@ drag() { at "$1" "$2"; xdotool mousedown 1; sleep 0.3; xdotool mousemove --windo
 cut() { at "$1" "$2"; xdotool keydown shift; sleep 0.2; xdotool mousedown 3; sleep 0.3;
         xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5; xdotool mouseup 3; sleep 0.2; xdotool keyup shift; settle; }
 quit() { at 900 400; key Escape; }
-title_has() { for _ in $(seq 150); do xdotool getwindowname "$wid" | grep -qF -- "$1" && break; sleep 0.1; done; }
+title_has() { for _ in $(seq 600); do xdotool getwindowname "$wid" | grep -qF -- "$1" && break; sleep 0.1; done; }
 drop() { local x="$1" y="$2"; shift 2; "$XDND_DROP" "$wid" "$x" "$y" "$@" || echo "drop: not taken" >&2; settle; }
 shot() {
   rm -f clothsim-*.png
-  key F12
-  for _ in $(seq 150); do ls clothsim-*.png >/dev/null 2>&1 && break; sleep 0.1; done
-  sleep 0.3
-  mv clothsim-*.png "$1" || echo "shot $1: no screenshot was written" >&2
+  xdotool keydown F12; sleep 0.02; xdotool keyup F12
+  for _ in $(seq 600); do ls clothsim-*.png >/dev/null 2>&1 && break; sleep 0.05; done
+  local png
+  png=$(ls clothsim-*.png 2>/dev/null | head -n1)
+  if [ -z "$png" ]; then echo "shot $1: no screenshot was written" >&2; return; fi
+  mv "$png" "$1.partial"
+  frame  # a later frame has been drawn: the app has written the PNG whole
+  mv "$1.partial" "$1"
 }
 )sh";
 

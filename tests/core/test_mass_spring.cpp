@@ -2,6 +2,7 @@
 #include "support.hpp"
 
 #include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -170,4 +171,83 @@ TEST_CASE("mass_spring changing dt mid-run keeps the velocity (no jump)", "[mass
     // Free fall is exact for Verlet: any velocity jump at the change would show here.
     CHECK(sim.position(0).y == Approx(-0.5 * 9.81).margin(1e-4));
     CHECK(sim.velocities()[0].y == Approx(-9.81).margin(1e-3));
+}
+
+TEST_CASE("drag_pin: the pin travels to its target over one step, at most a quarter spacing a substep", "[pin]") {
+    Scene scene = load_scene("hanging");
+    scene.settings.springs.tether_strain = 0.0f;  // no tethers: the pin goes anywhere (the next test has them)
+    MassSpring sim = build_simulation(scene);
+    sim.run_steps(2);
+    std::size_t pin = 0;
+    while (!sim.particle(pin).pinned) ++pin;
+    const double spacing = sim.self_collision_spacing();
+    const int substeps = sim.settings().integration.substeps;
+    const glm::dvec3 start = sim.state().position.get(pin);
+    // A short drag (1 cm): the pin goes there at a steady pace, 1 / substeps of the way each substep.
+    const glm::vec3 near = glm::vec3(start) + glm::vec3(0.01f, 0.0f, 0.0f);
+    sim.drag_pin(pin, near);
+    REQUIRE(sim.pin_target(pin).has_value());
+    glm::dvec3 last = start;
+    for (int k = 0; k < substeps; ++k) {
+        sim.step();
+        const glm::dvec3 x = sim.state().position.get(pin);
+        CHECK(glm::length(x - last) == Approx(glm::length(glm::dvec3(near) - start) / substeps).epsilon(1e-3));
+        last = x;
+    }
+    CHECK(glm::length(last - glm::dvec3(near)) < 1e-6);
+    CHECK_FALSE(sim.pin_target(pin).has_value());
+    // A long one (1 m, 30 spacings): a quarter spacing a substep, then it stops at the target.
+    const glm::vec3 far = near + glm::vec3(0.0f, 0.0f, 1.0f);
+    sim.drag_pin(pin, far);
+    double longest = 0.0;
+    int taken = 0;
+    for (; taken < 1000 && sim.pin_target(pin); ++taken) {
+        const glm::dvec3 before = sim.state().position.get(pin);
+        sim.step();
+        longest = std::max(longest, glm::length(sim.state().position.get(pin) - before));
+    }
+    CHECK(longest == Approx(MassSpring::kPinStepPerSubstep * spacing).epsilon(1e-6));
+    CHECK(taken == static_cast<int>(std::ceil(1.0 / (MassSpring::kPinStepPerSubstep * spacing))));
+    CHECK(glm::length(sim.state().position.get(pin) - glm::dvec3(far)) < 1e-6);
+    // Freed, a pin forgets where it was going.
+    sim.drag_pin(pin, near);
+    sim.set_pinned(pin, false);
+    CHECK_FALSE(sim.pin_target(pin).has_value());
+}
+
+TEST_CASE("drag_pin: pins of hanging and curtain dragged fast, as a mouse does, never trip the guard", "[pin]") {
+    for (const char* name : {"hanging", "curtain"}) {
+        INFO(name);
+        MassSpring sim = build_simulation(load_scene(name));
+        std::vector<std::size_t> pins;
+        for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+            if (sim.particle(i).pinned) pins.push_back(i);
+        }
+        const std::size_t pin = pins.back();
+        std::string log;
+        REQUIRE(run_guarded(sim, 30, GuardSettings{}, log));
+        // 0.6 m in 0.25 s (15 steps of 4 cm: 2.4 m/s), down and sideways, then back in 5 steps (7 m/s).
+        glm::vec3 target = sim.position(pin);
+        for (int step = 0; step < 20; ++step) {
+            target += step < 15 ? glm::vec3(0.03f, -0.02f, 0.015f) : glm::vec3(-0.09f, 0.06f, -0.045f);
+            sim.drag_pin(pin, target);
+            const bool ok = run_guarded(sim, 1, GuardSettings{}, log);
+            INFO("step " << step << ": " << log);
+            REQUIRE(ok);
+        }
+        CHECK(log.empty());  // no step was retried
+        CHECK(max_strain(sim) < 1.0);
+        CHECK(sim.all_finite());
+        // With tethers, no pin ends farther from another than (1 + tether_strain) x their rest distance.
+        const double stretch = 1.0 + sim.settings().springs.tether_strain;
+        if (stretch > 1.0) {
+            const Scene scene = load_scene(name);
+            const MassSpring rest = build_simulation(scene);
+            for (std::size_t j : pins) {
+                const double now = glm::length(sim.state().position.get(pin) - sim.state().position.get(j));
+                const double at_rest = glm::length(rest.state().position.get(pin) - rest.state().position.get(j));
+                CHECK(now <= stretch * at_rest * (1.0 + 1e-6));
+            }
+        }
+    }
 }

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <string>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -189,6 +190,34 @@ StepCheck check_step(const MassSpring& sim, double energy_before, const GuardSet
     return {energy_ok ? BlowUp::None : BlowUp::Energy, energy};
 }
 
+namespace {
+
+// What the stability bound asks of the cloth as it is: the substeps a step needs and the stiffest spring kind,
+// for the guard's message ("the springs (structural 1e+09 N/m) need 73000 substeps per step").
+std::string what_bounds(const MassSpring& sim) {
+    const StabilityLimit limit = stability_limit(sim);
+    if (limit.unconditionally_stable || !(limit.critical_substep > 0.0)) return "";
+    const SpringSettings& k = sim.settings().springs;
+    const double structural = std::max(k.structural.x, k.structural.y), bending = std::max(k.bending.x, k.bending.y);
+    const char* kind = structural >= k.shear && structural >= bending ? "structural" : k.shear >= bending ? "shear" : "bending";
+    const double stiffest = std::max({structural, double(k.shear), bending});
+    const double needed = std::ceil(sim.settings().integration.dt / limit.critical_substep);
+    char text[200];
+    if (limit.bound == StabilityBound::Springs) {
+        std::snprintf(text, sizeof text, "; the springs (%s k = %.3g N/m) need %.0f substeps per step (substep %.3g s)",
+                      kind, stiffest, needed, limit.critical_substep);
+    } else {
+        std::snprintf(text, sizeof text, "; the %s need %.0f substeps per step (substep %.3g s)",
+                      limit.bound == StabilityBound::Damping ? "damping" : limit.bound == StabilityBound::Clips ? "soft clips" : "penalty contact",
+                      needed, limit.critical_substep);
+    }
+    return text;
+}
+
+}  // namespace
+
+// One message a step that needed the guard: what blew up, what held (or that nothing did, and what the
+// stability bound asks for).
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
     for (long long done = 0; done < steps; ++done) {
         if (sim.resting()) {  // asleep with nothing to wake it: the step moves nothing, there is nothing to check
@@ -197,30 +226,36 @@ bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, s
         }
         const MassSpring good = sim;  // the last good state
         const double energy_before = good.energy().total();
-        int retries = 0;
-        for (;;) {
+        const int first = sim.settings().integration.substeps;
+        BlowUp first_cause = BlowUp::None;
+        for (int retries = 0;; ++retries) {
             sim.run_steps(1);
             const BlowUp blow_up = check_step(sim, energy_before, guard).blow_up;
-            if (blow_up == BlowUp::None) break;
+            if (blow_up == BlowUp::None) {
+                if (retries > 0) {
+                    char line[256];
+                    std::snprintf(line, sizeof line,
+                                  "guard: t = %.4g s: the step blew up (%s) at %d substeps; rolled back, it held at "
+                                  "%d\n",
+                                  good.time(), blow_up_name(first_cause), first, sim.settings().integration.substeps);
+                    log += line;
+                }
+                break;
+            }
+            if (first_cause == BlowUp::None) first_cause = blow_up;
             const int substeps = sim.settings().integration.substeps;
-            char line[256];
             if (retries >= guard.max_retries || substeps >= kMaxSubsteps) {
-                std::snprintf(line, sizeof line,
-                              "guard: t = %.4g s: the step failed (%s) after %d retries; stopped at the last good "
-                              "state\n",
-                              good.time(), blow_up_name(blow_up), retries);
-                log += line;
                 sim = good;
+                char line[256];
+                std::snprintf(line, sizeof line,
+                              "guard: t = %.4g s: the step blew up (%s) at every substep count from %d to %d; rolled back "
+                              "and stopped at the last good state",
+                              good.time(), blow_up_name(blow_up), first, substeps);
+                log += line + what_bounds(sim) + "\n";
                 return false;
             }
             sim = good;
             sim.set_substeps(std::min(2 * substeps, kMaxSubsteps));
-            std::snprintf(line, sizeof line,
-                          "guard: t = %.4g s: the step blew up (%s); rolled back and doubled integration.substeps "
-                          "from %d to %d\n",
-                          good.time(), blow_up_name(blow_up), substeps, sim.settings().integration.substeps);
-            log += line;
-            ++retries;
         }
     }
     return true;

@@ -71,7 +71,8 @@ StepReport Stepper::run(MassSpring& sim, long long steps) {
     }
     if (policy_.guard) {
         report.guard_gave_up = !run_guarded(sim, steps, policy_.guard_settings, report.guard_log);
-        if (!report.guard_log.empty() && policy_.auto_substeps) {
+        // The guard chose the substeps that held; when nothing held it chose none and the substeps are as before.
+        if (!report.guard_log.empty() && !report.guard_gave_up && policy_.auto_substeps) {
             policy_.auto_substeps = false;
             report.guard_log += "auto substeps turned off to keep the guard's choice\n";
         }

@@ -170,13 +170,16 @@ public:
     // next step (the mouse's speed: the distance over integration.dt), a part of it each substep, and never
     // faster than kPinStepPerSubstep of the cloth's particle spacing per substep, the speed an explicit solver
     // follows (the Courant-Friedrichs-Lewy condition: a disturbance crosses at most one spacing per substep).
-    // So a drag moves the pin smoothly whatever the frame rate, instead of one jump a frame. While tethers
-    // act (springs.tether_strain > 0) the pin goes no farther from any other pin than (1 + tether_strain)
-    // times their rest distance: the cloth between them does not reach farther, and the tethers could not all
-    // hold. The pin keeps going until it reaches the target (or that limit); calling again moves the target.
-    // Wakes the cloth. Does nothing to a free particle; freeing the pin drops its target.
+    // So a drag moves the pin smoothly whatever the frame rate, instead of one jump a frame. The pin goes no
+    // farther from any other pin than (1 + tether_strain) times their rest distance while tethers act (the
+    // tethers could not all hold beyond), else (1 + kPinDragStretch) times: the cloth between two pins holds
+    // the pin there, as a real cloth would, instead of its few springs stretching without end (which the
+    // guard takes for a blow-up). The pin keeps going until it reaches the target (or that limit); calling
+    // again moves the target. Wakes the cloth. Does nothing to a free particle; freeing the pin drops its
+    // target.
     void drag_pin(std::size_t i, glm::vec3 target);
     static constexpr double kPinStepPerSubstep = 0.25;
+    static constexpr double kPinDragStretch = 0.5;
     // Where a dragged pin is heading (nothing when it is not dragged or has arrived).
     std::optional<glm::vec3> pin_target(std::size_t i) const;
     // A user's grab: free particle `i` is pulled toward `target` by a stiff, critically damped spring whose
@@ -243,8 +246,8 @@ private:
     float grab_force_limit(std::size_t i) const;
     // The first stage of a substep: dragged pins step toward their targets (drag_pin). Returns whether any moved.
     bool move_dragged_pins();
-    // Where pin i may go on its way to `x` while tethers act (drag_pin).
-    glm::dvec3 within_tether_reach(std::size_t i, glm::dvec3 from, glm::dvec3 x) const;
+    // Where pin i may go on its way to `x`, within reach of the other pins (drag_pin).
+    glm::dvec3 within_reach_of_pins(std::size_t i, glm::dvec3 from, glm::dvec3 x) const;
 
     // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
     struct FastSolverHolder {

@@ -830,20 +830,20 @@ bool MassSpring::move_dragged_pins() {
         if (!std::isfinite(length)) return true;  // a NaN target is dropped where the pin is
         const bool arrives = !(length > t.reach * (1.0 + 1e-9));
         glm::dvec3 to = arrives ? t.target : x + d * (t.reach / length);
-        if (plan_.tethers) to = within_tether_reach(t.particle, x, to);
+        to = within_reach_of_pins(t.particle, x, to);
         const double step = glm::length(to - x);
         moved = moved || step > 0.0;
         state_.position.set(t.particle, to);
-        return arrives || !(step > 1e-6 * t.reach);  // arrived, or held at the tethers' reach
+        return arrives || !(step > 1e-6 * t.reach);  // arrived, or held at the other pins' reach
     });
     return moved;
 }
 
-// Cyclic projection onto the balls around the other pins (radius (1 + tether_strain) x the rest distance):
-// their intersection is convex and holds `from`, where the pin is, so a few rounds land in it or near; a
-// point still outside any ball (by more than rounding) leaves the pin where it is.
-glm::dvec3 MassSpring::within_tether_reach(std::size_t i, glm::dvec3 from, glm::dvec3 x) const {
-    const double stretch = 1.0 + double(settings_.springs.tether_strain);
+// Cyclic projection onto the balls around the other pins (radius (1 + tether_strain or kPinDragStretch) x the
+// rest distance): their intersection is convex and holds `from`, where the pin is, so a few rounds land in it
+// or near; a point still outside any ball (by more than rounding) leaves the pin where it is.
+glm::dvec3 MassSpring::within_reach_of_pins(std::size_t i, glm::dvec3 from, glm::dvec3 x) const {
+    const double stretch = 1.0 + (plan_.tethers ? double(settings_.springs.tether_strain) : kPinDragStretch);
     const glm::dvec3 rest = rest_position_.get(i);
     auto outside = [&](std::size_t j, glm::dvec3 p) {
         return glm::length(p - state_.position.get(j)) > stretch * glm::length(rest - rest_position_.get(j)) * (1.0 + 1e-9);

@@ -692,9 +692,9 @@ void stats_section(const AppState& app) {
     // This frame's wall time, in parts that add up: the physics, the drawing, and the rest (the buffer swap,
     // vsync's wait, input).
     const Stats& st = app.stats;
-    ImGui::Text("%.0f FPS; frame %.1f ms = simulation %.1f + render %.1f + swap and wait %.1f", io.Framerate,
-                st.frame_ms, st.sim_ms, st.render_ms, std::max(st.frame_ms - st.sim_ms - st.render_ms, 0.0f));
-    ImGui::TextDisabled("%lld substeps this frame", st.substeps_last_frame);
+    ImGui::Text("%.0f FPS: frame %.1f ms (%lld substeps)", io.Framerate, st.frame_ms, st.substeps_last_frame);
+    ImGui::Text("= simulation %.1f + render %.1f + swap, wait %.1f", st.sim_ms, st.render_ms,
+                std::max(st.frame_ms - st.sim_ms - st.render_ms, 0.0f));
     if (app.sim.broken_springs() > 0) {  // torn or cut: as --json's broken_springs
         ImGui::Text("%zu particles, %zu springs (%zu broken), t = %.2f s", app.sim.particle_count(),
                     app.sim.spring_count(), app.sim.broken_springs(), app.sim.time());
@@ -717,11 +717,17 @@ void stats_section(const AppState& app) {
     // Said only while the simulation cannot keep up with the time scale; a line kept in place (blank when it
     // keeps up) so nothing below it moves.
     if (!app.paused && app.stats.speed < 0.9f * app.time_scale) {
-        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2fx real time, not %.2fx (%s)",
-                           app.stats.speed, app.time_scale,
-                           app.stats.sim_ms > 1e3 * app.stepper.policy().frame_budget
-                               ? "a step takes longer than the frame budget"
-                               : "the frames are too slow");
+        // One step's ms this frame: over the budget, the physics is what cannot keep up; under it, the frames.
+        const long long steps = app.stats.substeps_last_frame / std::max(app.sim.settings().integration.substeps, 1);
+        const double step_ms = steps > 0 ? app.stats.sim_ms / double(steps) : 0.0;
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "running slow: %.2fx real time (%s)", app.stats.speed,
+                           step_ms > 1e3 * app.stepper.policy().frame_budget ? "a step > frame budget" : "slow frames");
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("simulated seconds per wall second over the last half second, against the time scale "
+                              "%.2fx;\na step > frame budget: one step of physics takes longer than the frame budget "
+                              "(Integration);\nslow frames: the drawing or the buffer swap takes the time",
+                              app.time_scale);
+        }
     } else {
         ImGui::TextUnformatted("");
     }

@@ -845,21 +845,29 @@ bool MassSpring::move_dragged_pins() {
 glm::dvec3 MassSpring::within_reach_of_pins(std::size_t i, glm::dvec3 from, glm::dvec3 x) const {
     const double stretch = 1.0 + (plan_.tethers ? double(settings_.springs.tether_strain) : kPinDragStretch);
     const glm::dvec3 rest = rest_position_.get(i);
-    auto outside = [&](std::size_t j, glm::dvec3 p) {
-        return glm::length(p - state_.position.get(j)) > stretch * glm::length(rest - rest_position_.get(j)) * (1.0 + 1e-9);
+    // The other pins and how far from each the pin may go, found once.
+    struct Ball {
+        glm::dvec3 centre;
+        double radius;
     };
+    std::vector<Ball> balls;
+    for (std::size_t j = 0; j < state_.size(); ++j) {
+        if (j != i && state_.pinned[j] == kPinned) {
+            balls.push_back({state_.position.get(j), stretch * glm::length(rest - rest_position_.get(j))});
+        }
+    }
+    auto outside = [](const Ball& b, glm::dvec3 p) { return glm::length(p - b.centre) > b.radius * (1.0 + 1e-9); };
     for (int round = 0; round < 4; ++round) {
         bool moved = false;
-        for (std::size_t j = 0; j < state_.size(); ++j) {
-            if (j == i || state_.pinned[j] != kPinned || !outside(j, x)) continue;
-            const glm::dvec3 pin = state_.position.get(j);
-            x = pin + (x - pin) * (stretch * glm::length(rest - rest_position_.get(j)) / glm::length(x - pin));
+        for (const Ball& b : balls) {
+            if (!outside(b, x)) continue;
+            x = b.centre + (x - b.centre) * (b.radius / glm::length(x - b.centre));
             moved = true;
         }
         if (!moved) return x;
     }
-    for (std::size_t j = 0; j < state_.size(); ++j) {
-        if (j != i && state_.pinned[j] == kPinned && outside(j, x)) return from;
+    for (const Ball& b : balls) {
+        if (outside(b, x)) return from;
     }
     return x;
 }

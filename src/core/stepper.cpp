@@ -35,10 +35,10 @@ StepReport Stepper::advance(MassSpring& sim, double seconds) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     accumulator_ += seconds;
+    choose_substeps(sim);  // also when no step is owed: auto substeps follows the panel's edits
+    const double dt = sim.settings().integration.dt;
     StepReport report;
     for (;;) {
-        choose_substeps(sim);
-        const double dt = sim.settings().integration.dt;
         if (accumulator_ < dt) break;
         if (report.steps > 0 && std::chrono::duration<double>(Clock::now() - start).count() >= policy_.frame_budget) {
             // Over budget with whole steps still owed: they are dropped, the fraction of a step is kept.

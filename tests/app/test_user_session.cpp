@@ -79,6 +79,12 @@ glm::vec3 particle_on_screen(const clothsim::Scene& scene, std::size_t i) {
     return to_screen(start_camera(sim), sim.particle(i).position);
 }
 
+// A particle in the middle of `scene`'s grid (the middle row's middle one, for an even row count the row after).
+std::size_t middle_particle(const clothsim::Scene& scene) {
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    return sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+}
+
 std::vector<std::size_t> pinned_particles(const clothsim::Scene& scene) {
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
     std::vector<std::size_t> pins;
@@ -229,8 +235,7 @@ TEST_CASE("user session: ctrl+click on a pin and a grab before the first step, w
     const clothsim::Scene scene = clothsim::load_scene("hanging");
     const std::vector<std::size_t> pins = pinned_particles(scene);
     REQUIRE(!pins.empty());
-    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
-    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const std::size_t middle = middle_particle(scene);
     const glm::vec3 grab = particle_on_screen(scene, middle);
     const TempDir dir("session_pin_grab");
     const RunResult r = run_user_session(
@@ -262,8 +267,7 @@ TEST_CASE("user session: a launch whose first step the guard rejects keeps drawi
 
 TEST_CASE("user session: a hard, fast drag on curtain pulls the cloth without the guard stepping in") {
     const clothsim::Scene scene = clothsim::load_scene("curtain");
-    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
-    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const std::size_t middle = middle_particle(scene);
     const glm::vec3 from = particle_on_screen(scene, middle);
     const TempDir dir("session_hard_drag");
     // 400 px in one jump of the mouse, held half a second, released, then the cloth plays on for 2 s.
@@ -545,8 +549,7 @@ TEST_CASE("user session: the reset button and the right-click menu bring a dragg
 
 TEST_CASE("user session: R keeps a pin placed by hand, and Revert drops it") {
     const clothsim::Scene scene = clothsim::load_scene("hanging");
-    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
-    const std::size_t middle = sim.particle_count() / 2 + static_cast<std::size_t>(sim.topology().cols / 2);
+    const std::size_t middle = middle_particle(scene);
     const glm::vec3 at = particle_on_screen(scene, middle);
     const TempDir dir("session_reset_keeps_pins");
     const RunResult r = run_user_session(

@@ -95,7 +95,7 @@ Bounds sane_bounds(const MassSpring& sim) {
 // An empty string when the cloth is within `b`, else what is wrong (the first particle found).
 std::string bounds_violation(const MassSpring& sim, const Bounds& b, double strain) {
     const ColliderSettings& c = sim.settings().colliders;
-    char buf[256];
+    char buf[256], where[96];
     for (std::size_t i = 0; i < sim.particle_count(); ++i) {
         const glm::vec3 p = sim.position(i);
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;  // the finite check's
@@ -103,14 +103,13 @@ std::string bounds_violation(const MassSpring& sim, const Bounds& b, double stra
         float depth = 0.0f;
         if (glm::any(glm::lessThan(p, b.lo)) || glm::any(glm::greaterThan(p, b.hi))) {
             what = "outside the scene box";
-        } else if (c.ground.enabled && (depth = -signed_distance(c.ground, p)) > kPenetration) {
-            what = "below the ground";
-        } else if (c.sphere.enabled && (depth = -signed_distance(c.sphere, p)) > kPenetration) {
-            what = "inside the sphere";
-        } else if (c.cube.enabled && (depth = -signed_distance(c.cube, p)) > kPenetration) {
-            what = "inside the cube";
-        } else if (c.cylinder.enabled && (depth = -signed_distance(c.cylinder, p)) > kPenetration) {
-            what = "inside the cylinder";
+        } else {
+            for (std::size_t k = 0; k < c.shapes.size() && !what; ++k) {
+                const Collider& collider = c.shapes[k];
+                if (!collider.enabled || (depth = -signed_distance(collider, p)) <= kPenetration) continue;
+                std::snprintf(where, sizeof where, "inside collider %zu (%s)", k, std::string(kind_name(collider)).c_str());
+                what = where;
+            }
         }
         if (what) {
             std::snprintf(buf, sizeof buf, "particle %zu at (%.4g, %.4g, %.4g) %s", i, p.x, p.y, p.z, what);
@@ -144,10 +143,9 @@ struct Result {
 
 std::string enabled_colliders(const ColliderSettings& c) {
     std::string s;
-    if (c.sphere.enabled) s += "sphere ";
-    if (c.cube.enabled) s += "cube ";
-    if (c.cylinder.enabled) s += "cylinder ";
-    if (c.ground.enabled) s += "ground ";
+    for (const Collider& collider : c.shapes) {
+        if (collider.enabled) s += std::string(kind_name(collider)) + " ";
+    }
     if (s.empty()) return "none";
     s.pop_back();
     return s;
@@ -170,9 +168,12 @@ Result soak(const SoakScene& which, const Options& opt, std::ofstream& csv) {
     // A bundled scene in its per-spring form (tests/per_spring_scenes.hpp): the recorded soaks' workload.
     Scene scene = load_per_spring(which.scene);
     const ColliderSettings& bundled = scene.settings.colliders;
-    const bool has_collider = (which.key == "sphere" && bundled.sphere.enabled) ||
-                              (which.key == "cube" && bundled.cube.enabled) ||
-                              (which.key == "ground" && bundled.ground.enabled) || which.key == which.scene;
+    // The key names a first-form section (sphere, cube, ground): its kind must be enabled in the scene.
+    const int kind = find_collider_kind(which.key);
+    const bool has_collider = which.key == which.scene ||
+                              std::any_of(bundled.shapes.begin(), bundled.shapes.end(), [&](const Collider& c) {
+                                  return c.enabled && static_cast<int>(c.kind()) == kind;
+                              });
     if (!has_collider) {
         throw SceneError("scene '" + which.scene + "' is meant to soak the " + which.key +
                          " collider but does not enable it (colliders: " + enabled_colliders(bundled) + ")");

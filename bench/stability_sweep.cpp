@@ -37,7 +37,7 @@ Scene scene_for(const Case& c, double h) {
     s.settings.springs.shear = 0.1f * c.stiffness;
     s.settings.springs.bending = glm::vec2(0.025f * c.stiffness);
     s.settings.springs.damping = c.damping;
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();  // no ground
     s.settings.integration.integrator = c.integrator;
     s.settings.integration.dt = static_cast<float>(h);
     s.settings.integration.substeps = 1;

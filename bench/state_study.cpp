@@ -346,7 +346,7 @@ constexpr std::array<int, 3> kSubsteps = {136, 544, 4096};
 Scene smooth_scene() {
     Scene s = per_spring_scene("hanging");  // the per-spring cloth docs/ACCURACY.md's figures measured
     s.cloth.rows = s.cloth.cols = 32;
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();  // no ground
     s.settings.integration.dt = kStep;
     return s;
 }

@@ -32,7 +32,7 @@ constexpr float kStep = 1.0f / 60.0f;  // s: one step (an app frame); the sweep 
 Scene sweep_scene() {
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 32;
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();  // no ground
     s.settings.integration.dt = kStep;
     s.name = "smooth-32";
     return s;

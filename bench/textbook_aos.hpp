@@ -46,15 +46,22 @@ public:
             b.force -= f;
         }
         const float keep = 1.0f - c * h / (1.0f + 0.5f * c * h), h2 = h * h / (1.0f + 0.5f * c * h);
-        const GroundCollider& ground = settings_.colliders.ground;
-        const float floor = ground.height + settings_.colliders.thickness;
+        // The scene's first plane (the ground), the only collider this reference model knows.
+        bool grounded = false;
+        float floor = 0.0f;
+        for (const Collider& collider : settings_.colliders.shapes) {
+            if (const auto* plane = std::get_if<PlaneCollider>(&collider.shape); plane && collider.enabled && !grounded) {
+                grounded = true;
+                floor = plane->height + settings_.colliders.thickness;
+            }
+        }
         for (Particle& p : particles_) {
             if (p.pinned) continue;
             const glm::vec3 a = p.force * p.inverse_mass + settings_.forces.gravity;
             const glm::vec3 next = p.position + (p.position - p.previous) * keep + a * h2;
             p.previous = p.position;
             p.position = next;
-            if (ground.enabled && p.position.y < floor) p.position.y = floor;
+            if (grounded && p.position.y < floor) p.position.y = floor;
         }
     }
 

@@ -31,7 +31,7 @@ Scene study_scene(const std::string& name) {
     if (name == "smooth") {
         Scene s = per_spring_scene("hanging");
         s.cloth.rows = s.cloth.cols = 16;
-        s.settings.colliders.ground.enabled = false;
+        s.settings.colliders.shapes.clear();  // no ground
         s.settings.springs.damping = 0.0f;
         s.name = "smooth";
         return s;

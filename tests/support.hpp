@@ -6,6 +6,8 @@
 #include <array>
 #include <cstring>
 #include <initializer_list>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 
 namespace clothsim::test {
@@ -35,10 +37,30 @@ inline Scene chain(int particles, float spacing, float particle_mass, float k) {
     s.pins.preset = PinPreset::None;
     s.settings.springs = {glm::vec2(k), 0.0f, glm::vec2(0.0f), 0.0f};
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();
     s.settings.integration.substeps = 1;
     return s;
 }
+
+// The first collider of a kind, by its first-form section name (sphere, cube, cylinder, ground): added switched
+// off where the first form put it when the list has none (scene.hpp: first_form_collider); a const list must
+// hold one.
+inline Collider& collider(ColliderSettings& c, std::string_view section) { return first_form_collider(c, section); }
+inline const Collider& collider(const ColliderSettings& c, std::string_view section) {
+    const int kind = find_collider_kind(section);
+    for (const Collider& x : c.shapes) {
+        if (static_cast<int>(x.kind()) == kind) return x;
+    }
+    throw std::logic_error("the scene has no " + std::string(section));
+}
+template <class Shape, class Colliders>
+auto& shape_of(Colliders& c, std::string_view section) {
+    return std::get<Shape>(collider(c, section).shape);
+}
+inline auto& sphere(auto& c) { return shape_of<SphereCollider>(c, "sphere"); }
+inline auto& box(auto& c) { return shape_of<BoxCollider>(c, "cube"); }
+inline auto& cylinder(auto& c) { return shape_of<CylinderCollider>(c, "cylinder"); }
+inline auto& plane(auto& c) { return shape_of<PlaneCollider>(c, "ground"); }
 
 // Whether two simulations hold the same positions and motion, bit for bit.
 inline bool bit_identical(const MassSpring& a, const MassSpring& b) {
@@ -68,7 +90,7 @@ inline MassSpring pulled_apart(SolverMethod method, float speed) {
     s.cloth.rows = s.cloth.cols = 12;
     s.pins.preset = PinPreset::None;
     s.settings.forces.gravity = glm::vec3(0.0f);
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();
     s.settings.springs.damping = 0.0f;
     s.settings.springs.tear_strain = 0.2f;
     s.settings.solver.method = method;
@@ -92,7 +114,7 @@ inline Scene disc_specimen(int n) {
     s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
     s.cloth.shape = ClothShape::Disc;
     s.pins.preset = PinPreset::None;
-    s.settings.colliders.ground.enabled = false;
+    s.settings.colliders.shapes.clear();
     return s;
 }
 

@@ -7,6 +7,7 @@
 // the test accepts (they allow a relative margin of 1e-5 for rounding), so culling never changes a result.
 #pragma once
 
+#include "clothsim/bounding_box.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
@@ -22,11 +23,6 @@ namespace clothsim {
 // tests; 16 is two AVX2 vectors (docs/PERFORMANCE.md has the drape figures).
 inline constexpr std::size_t kBlockParticles = 16;
 
-struct Box {
-    glm::vec3 lo{INFINITY};
-    glm::vec3 hi{-INFINITY};
-    bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
-};
 
 // The box around particles [begin, end); NaN coordinates are left out (a NaN particle touches nothing).
 // Positions are double and boxes float: a bound is rounded to the nearest float, within the tests' margin.
@@ -39,7 +35,7 @@ void include_motion(const DVec3Array& motion, std::size_t begin, std::size_t end
 // The box around boxes[0, n) (empty for n = 0), as glm::min and glm::max fold them: a NaN bound is left out.
 Box union_of(const Box* boxes, std::size_t n);
 
-// What the collision stage reads of a block's box. The ground (a half-space below a height) reads only the
+// What the collision stage reads of a block's box. A plane (a half-space below a height) reads only the
 // box's lowest y (may_touch), so when no other collider can reach the cloth each block needs only its lowest
 // point: a Lowest box is that bound with its other five sides open (+-infinity), still a conservative box,
 // found with one axis and one reduction instead of six (colliders.hpp: block_bounds_for chooses).
@@ -56,10 +52,7 @@ void row_block_bounds(const DVec3Array& position, std::size_t begin, std::size_t
 std::vector<std::size_t> block_starts(std::size_t particles, int rows, int cols);
 inline std::size_t blocks_per_row(int cols) { return (static_cast<std::size_t>(cols) + kBlockParticles - 1) / kBlockParticles; }
 
-// Whether a particle in `box` can come closer than `thickness` to the collider's surface.
-bool may_touch(const SphereCollider& sphere, float thickness, const Box& box);
-bool may_touch(const CubeCollider& cube, float thickness, const Box& box);
-bool may_touch(const CylinderCollider& cylinder, float thickness, const Box& box);
-bool may_touch(const GroundCollider& ground, float thickness, const Box& box);
+// Whether a particle in a box can come closer than `thickness` to a collider's surface: each shape's may_touch
+// (shapes/).
 
 }  // namespace clothsim

@@ -1,18 +1,18 @@
-// Collision with a sphere, an axis-aligned box, a vertical cylinder and the ground plane: the projection
+// Collision with the scene's list of shapes (collider.hpp: spheres, boxes, cylinders, planes): the projection
 // contact model (colliders.contact = projection, the default; penalty_contact.hpp in src/core has the smooth
 // force model).
 //
 // After integration every free particle closer than `thickness` to a collider surface is projected out
-// to that distance along the surface normal (the box and the cylinder: along the shortest way out). The
+// to that distance along the surface normal (a box and a cylinder: along the shortest way out). The
 // contact is inelastic: the inward part of the substep's motion is removed, and the push itself adds no
 // velocity. Friction acts on the tangential motion like Coulomb friction in position-based dynamics (Mueller
 // et al. 2007, Macklin et al. 2014): it is reduced by at most mu times the normal correction, and stops
 // when it is smaller (static friction). A particle resting on a plane is pushed
 // back by g h^2 each substep, so its sliding velocity drops by mu g h per substep: deceleration mu g.
 //
-// Continuous collision: a particle whose path over the substep (x - motion -> x) went through the sphere, the
-// box or the cylinder, though it ends outside (or inside, past the middle), is stopped where the path entered
-// the thickness shell, its inward motion removed. The ground is a half-space and needs no sweep.
+// Continuous collision: a particle whose path over the substep (x - motion -> x) went through a solid shape,
+// though it ends outside (or inside, past the middle), is stopped where the path entered the thickness shell,
+// its inward motion removed. A plane is a half-space and needs no sweep.
 #pragma once
 
 #include "clothsim/broad_phase.hpp"
@@ -30,23 +30,12 @@
 
 namespace clothsim {
 
-// Signed distance from p to the collider surface (m): negative inside.
-float signed_distance(const SphereCollider& sphere, glm::vec3 p);
-float signed_distance(const CubeCollider& cube, glm::vec3 p);
-float signed_distance(const CylinderCollider& cylinder, glm::vec3 p);
-float signed_distance(const GroundCollider& ground, glm::vec3 p);
-
-// Collision stages for particles [begin, end) (all by default). Pinned particles are never moved.
+// Collision of particles [begin, end) (all by default) with one collider, enabled or not. Pinned particles
+// are never moved.
 inline constexpr std::size_t kAllParticles = static_cast<std::size_t>(-1);
-void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin = 0,
+void collide(State& state, const Collider& collider, float thickness, std::size_t begin = 0,
              std::size_t end = kAllParticles);
-void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin = 0,
-             std::size_t end = kAllParticles);
-void collide(State& state, const CylinderCollider& cylinder, float thickness, std::size_t begin = 0,
-             std::size_t end = kAllParticles);
-void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin = 0,
-             std::size_t end = kAllParticles);
-// Every enabled collider, in the order sphere, cube, cylinder, ground, testing every particle (the reference solution).
+// Every enabled collider, in the list's order, testing every particle (the reference solution).
 void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
 
@@ -57,9 +46,9 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
 // by its motion, so the box grown by the motion's bounds (and by zero: it keeps where the particles started)
 // holds them after it. A tether keeps its particle in it (it moves the particle toward its pin) and moves its
 // path's start by at most its motion, which the box grows by (MassSpring::step); any other move (a collider's
-// push, a limit, self-collision, an edit) and any substep without a sphere, cube or cylinder make it invalid
-// until the next whole boxes. While it lies out of reach of those colliders, the blocks need only their
-// lowest points (for the ground) and those colliders cost one test each.
+// push, a limit, self-collision, an edit) and any substep without a solid shape make it invalid until the
+// next whole boxes. While it lies out of reach of the solid shapes, the blocks need only their lowest points
+// (for the planes) and each solid shape costs one test.
 struct CollisionBlocks {
     std::vector<std::size_t> start;  // block k is particles [start[k], start[k + 1])
     std::vector<Box> boxes;          // one per block
@@ -88,21 +77,21 @@ struct CollisionBlocks {
 // here unless the fast solver left them (boxes_current), and a block's box is grown by the farthest push a
 // collider gave one of its particles, so the next collider's test stays conservative.
 // Each collider's time and block counts go to `profile` when it is not null. `threads` share the blocks a
-// collider tests when they hold kParallelCollisionParticles particles or more (four times as many for the
-// ground; the same result for any count). Returns false when no particle was tested against any collider, so
+// collider tests when they hold kParallelCollisionParticles particles or more (four times as many for a
+// plane; the same result for any count). Returns false when no particle was tested against any collider, so
 // none moved. `motion`, when not null, bounds every particle's motion as it is now (the fast solver's sweep
 // takes them while it writes the motions): the swept boxes' reach then costs no pass over the motions.
 //
-// With Lowest boxes from the caller and the sphere, the cube or the cylinder enabled, those test the carried
-// box, grown here by `motion` (null: the caller has kept it since the sweep); when it may reach
-// one of them, or cannot be grown (bounds that are not finite), the stage makes whole boxes itself.
+// With Lowest boxes from the caller and a solid shape enabled, the solid shapes test the carried box, grown
+// here by `motion` (null: the caller has kept it since the sweep); when it may reach one of them, or cannot
+// be grown (bounds that are not finite), the stage makes whole boxes itself.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
                    StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr);
 
 // What the fast solver's sweep should compute of each block for the next substep's collision stage: Lowest
-// when the ground is the only collider, or when the carried box is valid and out of reach of the sphere, the
-// cube and the cylinder; whole boxes otherwise.
+// when planes are the only colliders, or when the carried box is valid and out of reach of every solid shape;
+// whole boxes otherwise.
 BlockBounds block_bounds_for(const ColliderSettings& colliders, const CollisionBlocks& blocks);
 
 }  // namespace clothsim

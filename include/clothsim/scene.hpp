@@ -9,6 +9,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <span>
@@ -56,6 +57,29 @@ std::string describe_allowed(const FieldInfo& field);
 std::string format_value(const Scene& scene, const FieldInfo& field);
 // Sets `field` of `to` to its value in `from` (the panel's "reset to scene value / built-in default").
 void copy_field(const FieldInfo& field, const Scene& from, Scene& to);
+
+// ---- The colliders' fields: [[colliders.shapes]] entries, each `kind` plus that kind's rows. ----
+// One row of one collider: `enabled` and `friction` (every kind), then its kind's rows (shapes/*.hpp kFields).
+struct ColliderField {
+    std::string_view name;  // within the entry: "radius"
+    std::string_view unit;
+    double min, max;
+    std::string_view help;
+    FieldRef ref;  // into the collider
+};
+std::vector<ColliderField> collider_fields(Collider& collider);
+// The rows of a kind as a default collider of it holds them (for listings: --list-fields, the docs).
+std::vector<ColliderField> collider_fields_of_kind(std::size_t kind);
+std::string describe_allowed(const ColliderField& field);
+std::string format_value(const ColliderField& field);
+// The kind named `name` (an index of ColliderShape), or -1. "cube" reads as "box" and "ground" as "plane" (the
+// first scene-file form's names).
+int find_collider_kind(std::string_view name);
+// The first form's sections, [colliders.sphere], [colliders.cube], [colliders.cylinder], [colliders.ground]:
+// each addresses the first collider of its kind in the list, added where the first form ordered it (sphere,
+// cube, cylinder, ground), switched off, when the list has none. Returns that collider.
+inline constexpr std::array<std::string_view, 4> kFirstFormSections = {"sphere", "cube", "cylinder", "ground"};
+Collider& first_form_collider(ColliderSettings& colliders, std::string_view section);
 
 // ---- Names of the enumerations, as written in files. ----
 std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge

@@ -5,6 +5,8 @@
 // (the field table); the comments here only repeat the unit.
 #pragma once
 
+#include "clothsim/collider.hpp"
+
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -143,45 +145,9 @@ struct PinSpec {
     bool operator==(const PinSpec&) const = default;
 };
 
-struct SphereCollider {
-    bool enabled = false;
-    glm::vec3 center{0.0f, 0.5f, 0.0f};  // m
-    float radius = 0.3f;                 // m
-    float friction = 0.3f;               // Coulomb coefficient (0 = frictionless)
-    bool operator==(const SphereCollider&) const = default;
-};
-
-struct CubeCollider {
-    bool enabled = false;
-    glm::vec3 center{0.0f, 0.4f, 0.0f};     // m
-    glm::vec3 size{0.5f, 0.5f, 0.5f};       // m: edge lengths along x, y, z (axis-aligned)
-    float friction = 0.3f;
-    bool operator==(const CubeCollider&) const = default;
-};
-
-// A solid cylinder with a vertical axis, such as the support disc of the Cusick drape tester (ISO 9073-9,
-// BS 5058: an 18 cm disc). Its flat top is at center.y + height / 2, its flat bottom at center.y - height / 2.
-struct CylinderCollider {
-    bool enabled = false;
-    glm::vec3 center{0.0f, 0.25f, 0.0f};  // m: the middle of the axis
-    float radius = 0.09f;                 // m
-    float height = 0.5f;                  // m: from the bottom face to the top face
-    float friction = 0.3f;
-    bool operator==(const CylinderCollider&) const = default;
-};
-
-struct GroundCollider {
-    bool enabled = true;
-    float height = 0.0f;     // m: the plane y = height
-    float friction = 0.5f;
-    bool operator==(const GroundCollider&) const = default;
-};
-
 struct ColliderSettings {
-    SphereCollider sphere;
-    CubeCollider cube;
-    CylinderCollider cylinder;
-    GroundCollider ground;
+    // The objects, in the order their contacts are resolved (collider.hpp); a new scene has the ground.
+    std::vector<Collider> shapes{Collider::of(PlaneCollider{})};
     float thickness = 0.005f;  // m: particles are kept this far outside every collider surface
     ContactModel contact = ContactModel::Projection;
     float contact_stiffness = 1000.0f;  // N/m: penalty contact's k_c (force k_c p^3 / thickness^2 at depth p)

@@ -1,11 +1,11 @@
 // StepPlan: which stages a substep runs, chosen from the scene.
 //
-// MassSpring builds the plan when it is constructed and again whenever its settings change (it compares
-// them with the ones the plan was made for, once per substep), never per particle. A stage that would do
+// MassSpring builds the plan when it is constructed and again whenever its settings change (MassSpring::apply
+// replans at the point of change), never per particle. A stage that would do
 // nothing is not run at all: a spring kind with stiffness 0 or no springs, zero wind, a disabled collider,
-// no strain or speed limit. The contact model picks the colliders' stages: projection runs the sphere, cube,
-// cylinder and ground stages after integration; penalty contact runs none of them and adds a force stage
-// ("contact") beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
+// no strain or speed limit. The contact model picks the colliders' stage: projection runs the colliders
+// stage (every enabled shape in the list) after integration; penalty contact does not run it and adds a force
+// stage ("contact") beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
 // costs no instruction in the hot loop (src/core/fast_solver.cpp). Gravity and damping are coefficients of
 // the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
 #pragma once
@@ -33,7 +33,8 @@ struct StepPlan {
     bool wind = false;
     bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)
     bool holds = false;    // soft clips hold particles: a force stage
-    bool sphere = false, cube = false, cylinder = false, ground = false;  // the projection stages (projection contact)
+    bool colliders = false;  // the projection stage (projection contact, a collider enabled)
+    bool solids = false;     // ... and a solid shape among them (not only planes): the blocks need whole boxes
     bool tethers = false;  // springs.tether_strain > 0 and the cloth has pins to tie to
     bool strain_limit = false;
     bool speed_limit = false;
@@ -42,7 +43,6 @@ struct StepPlan {
     bool may_sleep = false;  // sleep_speed > 0 and the air is still: nothing in the settings drives the cloth
 
     bool any_springs() const { return springs[0] || springs[1] || springs[2]; }
-    bool any_collider() const { return sphere || cube || cylinder || ground; }
     // Forces besides the springs, gravity, damping and a grab, added on their own (add_external_forces).
     bool external_forces() const { return wind || contact || holds; }
     // Bit k set when spring kind k runs: the fast solver's variant.
@@ -68,8 +68,8 @@ struct StageStatus {
 };
 std::string_view state_name(StageState state);  // "runs", "fused", "skipped"
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings);
-// What the profile adds to a stage's note: for a collider that ran, "N of M blocks tested" (the broad
-// phase's work); otherwise the status's own note. One wording for the panel, the text report and the JSON.
+// What the profile adds to a stage's note: for the colliders stage that ran, "sphere N of M, plane ... blocks
+// tested" per kind (the broad phase's work); otherwise the status's own note. One wording for the panel, the text report and the JSON.
 std::string profile_note(const StageStatus& status, const StepProfile& profile);
 
 }  // namespace clothsim

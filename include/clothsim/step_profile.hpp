@@ -5,6 +5,8 @@
 // every frame and resets it; `clothsim --headless --json` reports the totals of the run.
 #pragma once
 
+#include "clothsim/collider.hpp"
+
 #include <array>
 #include <chrono>
 #include <cstddef>
@@ -20,10 +22,7 @@ enum class Stage {
     Fast,        // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
     BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth
-    Sphere,      // sphere collisions (broad and narrow phase; projection contact)
-    Cube,        // cube collisions
-    Cylinder,    // cylinder collisions
-    Ground,      // ground collisions
+    Colliders,   // collisions with every enabled shape (broad and narrow phase; projection contact)
     SelfCollision,  // the cloth against itself (collision.self; self_collision.hpp)
     Tethers,     // long-range attachments to the pins (tethers.hpp)
     StrainLimit, // Provot's strain limit
@@ -37,25 +36,14 @@ inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count
 // Lower-case names, as the panel and the JSON show them.
 std::string_view stage_name(Stage stage);
 
-// The collider a stage times, as an index of StepProfile's block counts (0 sphere, 1 cube, 2 cylinder,
-// 3 ground), or -1.
-inline constexpr std::size_t kColliderCount = 4;
-constexpr int collider_index(Stage stage) {
-    return stage == Stage::Sphere     ? 0
-           : stage == Stage::Cube     ? 1
-           : stage == Stage::Cylinder ? 2
-           : stage == Stage::Ground   ? 3
-                                      : -1;
-}
-
 struct StepProfile {
     std::array<double, kStageCount> ms{};         // wall time spent in each stage
     std::array<long long, kStageCount> runs{};    // times the stage ran: once a substep (colliders twice when a
                                                   // strain or speed limit runs; Sleep once a step)
-    // Collision broad phase, per collider (collider_index: sphere, cube, cylinder, ground): particle blocks
-    // whose box met the collider and were tested particle by particle, out of all blocks offered to it.
-    std::array<long long, kColliderCount> blocks_tested{};
-    std::array<long long, kColliderCount> blocks_offered{};
+    // Collision broad phase, per collider kind (collider.hpp's ColliderShape index): particle blocks whose box
+    // met a collider of that kind and were tested particle by particle, out of all blocks offered to them.
+    std::array<long long, kColliderKindCount> blocks_tested{};
+    std::array<long long, kColliderKindCount> blocks_offered{};
     // Self-collision: tiles boxed, tiles sent to the narrow phase, particle pairs pushed apart.
     long long self_tiles = 0, self_tiles_active = 0, self_contacts = 0;
     long long substeps = 0;         // substeps stepped

@@ -302,9 +302,12 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
         app.camera.orbit(delta);
     }
     if (io.MouseWheel != 0.0f) app.camera.zoom(io.MouseWheel);
-    // A ground that collides is solid: the camera never goes under it.
-    const GroundCollider& ground = app.sim.settings().colliders.ground;
-    if (ground.enabled) app.camera.keep_above(ground.height);
+    // A floor that collides is solid: the camera never goes under the lowest.
+    float floor = INFINITY;
+    for (const Collider& c : app.sim.settings().colliders.shapes) {
+        if (const auto* plane = std::get_if<PlaneCollider>(&c.shape); plane && c.enabled) floor = std::min(floor, plane->height);
+    }
+    if (std::isfinite(floor)) app.camera.keep_above(floor);
 }
 
 // Key presses and dropped files collected by GLFW callbacks, in front of Dear ImGui's own. ImGui 1.86 (before

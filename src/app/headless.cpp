@@ -41,9 +41,16 @@ nlohmann::json profile_json(const StepProfile& p, const std::vector<StageStatus>
                                 {"ms_per_step", steps > 0 ? p.ms[i] / double(steps) : 0.0},
                                 {"substeps_run", p.runs[i]},
                                 {"note", s.note}};
-        if (const int c = collider_index(s.stage); c >= 0) {
-            stage["blocks_tested"] = p.blocks_tested[c];
-            stage["blocks_offered"] = p.blocks_offered[c];
+        if (s.stage == Stage::Colliders) {
+            // Per kind (collider.hpp), for the kinds the scene holds.
+            nlohmann::json tested = nlohmann::json::object(), offered = nlohmann::json::object();
+            for (std::size_t kind = 0; kind < kColliderKindCount; ++kind) {
+                if (p.blocks_offered[kind] == 0) continue;
+                tested[std::string(collider_kind_names()[kind])] = p.blocks_tested[kind];
+                offered[std::string(collider_kind_names()[kind])] = p.blocks_offered[kind];
+            }
+            stage["blocks_tested"] = tested;
+            stage["blocks_offered"] = offered;
         }
         if (s.stage == Stage::SelfCollision) {
             stage["tiles"] = p.self_tiles;
@@ -66,7 +73,7 @@ void print_profile(const StepProfile& p, const std::vector<StageStatus>& stages,
         const std::size_t i = static_cast<std::size_t>(s.stage);
         if (s.runs()) {
             std::printf(" %s %.4f", std::string(stage_name(s.stage)).c_str(), steps > 0 ? p.ms[i] / double(steps) : 0.0);
-            if (collider_index(s.stage) >= 0 || s.stage == Stage::SelfCollision) {
+            if (s.stage == Stage::Colliders || s.stage == Stage::SelfCollision) {
                 std::printf(" (%s)", profile_note(s, p).c_str());
             }
             std::printf(";");
@@ -278,9 +285,12 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     }
     out["solver"] = solver;
     // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.
-    const CylinderCollider& support = sim.settings().colliders.cylinder;
-    if (scene.cloth.shape == ClothShape::Disc && support.enabled) {
-        const DrapeFigures drape = measure_drape(sim, glm::dvec3(support.center), support.radius);
+    const CylinderCollider* support = nullptr;
+    for (const Collider& c : sim.settings().colliders.shapes) {
+        if (!support && c.enabled) support = std::get_if<CylinderCollider>(&c.shape);
+    }
+    if (scene.cloth.shape == ClothShape::Disc && support) {
+        const DrapeFigures drape = measure_drape(sim, glm::dvec3(support->center), support->radius);
         out["drape_coefficient"] = finite_or_null(drape.drape_coefficient);
         out["folds"] = drape.folds;
         out["drape_outline"] = {drape.outline_min, drape.outline_max};

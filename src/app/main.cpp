@@ -153,6 +153,14 @@ bool print_lists(const CommandLine& cl) {
             std::cout << f.name << (f.unit.empty() ? "" : " (" + std::string(f.unit) + ")") << ": " << f.help
                       << "; allowed: " << describe_allowed(f) << "; default: " << format_value(Scene{}, f) << "\n";
         }
+        // Each collider kind's fields, as a [[colliders.shapes]] entry (kind = "...") holds them.
+        for (std::size_t kind = 0; kind < kColliderKindCount; ++kind) {
+            for (const ColliderField& f : collider_fields_of_kind(kind)) {
+                std::cout << "colliders.shapes[kind = " << collider_kind_names()[kind] << "]." << f.name
+                          << (f.unit.empty() ? "" : " (" + std::string(f.unit) + ")") << ": " << f.help
+                          << "; allowed: " << describe_allowed(f) << "; default: " << format_value(f) << "\n";
+            }
+        }
         return true;
     }
     return false;

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -628,18 +629,66 @@ void integration_section(Scene& edit, AppState& app) {
     }
 }
 
+// One collider's rows: its fields as drags (clamped to their range), each with its tooltip. Returns true when
+// the user changed one.
+bool collider_rows(Collider& collider) {
+    bool changed = false;
+    for (const ColliderField& f : collider_fields(collider)) {
+        std::string label(f.name);
+        if (!f.unit.empty()) label += " (" + std::string(f.unit) + ")";
+        const auto lo = static_cast<float>(f.min), hi = static_cast<float>(f.max);
+        changed |= std::visit(Overloaded{
+                                  [&](bool* v) { return ImGui::Checkbox(label.c_str(), v); },
+                                  [&](float* v) {
+                                      const float speed = std::max(std::fabs(*v) * 0.01f, 0.001f);
+                                      return ImGui::DragFloat(label.c_str(), v, speed, lo, hi, "%.4g",
+                                                              ImGuiSliderFlags_AlwaysClamp);
+                                  },
+                                  [&](glm::vec3* v) {
+                                      const float speed = std::max(0.005f, 0.01f * std::max({std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)}));
+                                      return ImGui::DragFloat3(label.c_str(), &v->x, speed, lo, hi, "%.3g",
+                                                               ImGuiSliderFlags_AlwaysClamp);
+                                  },
+                                  [&](auto*) { return false; },
+                              },
+                              f.ref);
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("%s\nallowed: %s", std::string(f.help).c_str(), describe_allowed(f).c_str());
+        }
+    }
+    return changed;
+}
+
 void colliders_section(Scene& edit, AppState& app) {
-    ImGui::TextDisabled("sphere");
-    fields_section(edit, app, "colliders.sphere.");
+    // The list of shapes: each a tree node named by kind and place in the list, with its fields and a remove
+    // button; an add combo below. Edits apply live (MassSpring::apply), as any setting.
+    std::vector<Collider>& shapes = edit.settings.colliders.shapes;
+    std::optional<std::size_t> removed;
+    for (std::size_t i = 0; i < shapes.size(); ++i) {
+        ImGui::PushID(static_cast<int>(i));
+        const std::string title = std::to_string(i) + ": " + std::string(kind_name(shapes[i])) +
+                                  (shapes[i].enabled ? "" : " (off)");
+        const bool open = ImGui::TreeNodeEx("shape", ImGuiTreeNodeFlags_DefaultOpen, "%s", title.c_str());
+        ImGui::SameLine();
+        if (ImGui::SmallButton("remove")) removed = i;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("remove this collider from the scene");
+        if (open) {
+            collider_rows(shapes[i]);
+            ImGui::TreePop();
+        }
+        ImGui::PopID();
+    }
+    if (removed) shapes.erase(shapes.begin() + static_cast<std::ptrdiff_t>(*removed));
+    const auto names = collider_kind_names();
+    std::string kinds;
+    for (std::string_view name : names) kinds += (kinds.empty() ? "" : ", ") + std::string(name);
+    if (ImGui::BeginCombo("add collider", kinds.c_str())) {
+        for (std::size_t kind = 0; kind < names.size(); ++kind) {
+            if (ImGui::Selectable(std::string(names[kind]).c_str())) shapes.push_back(default_collider(kind));
+        }
+        ImGui::EndCombo();
+    }
     ImGui::Separator();
-    ImGui::TextDisabled("cube");
-    fields_section(edit, app, "colliders.cube.");
-    ImGui::Separator();
-    ImGui::TextDisabled("cylinder");
-    fields_section(edit, app, "colliders.cylinder.");
-    ImGui::Separator();
-    ImGui::TextDisabled("ground");
-    fields_section(edit, app, "colliders.ground.");
     fields_section(edit, app, "colliders.thickness");
     ImGui::Separator();
     ImGui::TextDisabled("contact model");

@@ -208,10 +208,6 @@ const bool kAvx2 = [] {
     return __builtin_cpu_supports("avx2") != 0;
 }();
 
-// Room for rounding: a relative 1e-5 of the magnitudes involved (float's epsilon is 6e-8).
-float margin(float scale) { return 1e-5f * (1.0f + scale); }
-float largest(glm::vec3 v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
-
 }  // namespace
 
 Box particle_bounds(const DVec3Array& position, std::size_t begin, std::size_t end) {
@@ -280,47 +276,6 @@ std::vector<std::size_t> block_starts(std::size_t particles, int rows, int cols)
     }
     start.push_back(particles);
     return start;
-}
-
-bool may_touch(const SphereCollider& sphere, float thickness, const Box& box) {
-    if (box.empty()) return false;
-    const glm::vec3 nearest = glm::clamp(sphere.center, box.lo, box.hi);
-    const glm::vec3 d = sphere.center - nearest;
-    const float reach = sphere.radius + thickness;
-    // |v| <= 2 x largest component for a 3-vector: a cheap stand-in for the lengths in the rounding margin.
-    const float grown = reach + margin(reach + 2.0f * (largest(sphere.center) + largest(nearest)));
-    return glm::dot(d, d) < grown * grown;
-}
-
-bool may_touch(const CubeCollider& cube, float thickness, const Box& box) {
-    if (box.empty()) return false;
-    const glm::vec3 half = 0.5f * cube.size + thickness;
-    const glm::vec3 grow(margin(2.0f * (largest(cube.center) + largest(half) + largest(box.lo) + largest(box.hi))));
-    const glm::vec3 lo = cube.center - half - grow, hi = cube.center + half + grow;
-    return box.lo.x < hi.x && box.hi.x > lo.x && box.lo.y < hi.y && box.hi.y > lo.y && box.lo.z < hi.z &&
-           box.hi.z > lo.z;
-}
-
-bool may_touch(const CylinderCollider& cylinder, float thickness, const Box& box) {
-    if (box.empty()) return false;
-    // Along the axis: the slab between the faces, each moved out by the thickness, meets the box's y range.
-    const float half = 0.5f * cylinder.height + thickness;
-    const float grow_y = margin(std::abs(cylinder.center.y) + half + std::abs(box.lo.y) + std::abs(box.hi.y));
-    if (!(box.lo.y < cylinder.center.y + half + grow_y && box.hi.y > cylinder.center.y - half - grow_y)) return false;
-    // Across it: the box's x-z rectangle comes within radius + thickness of the axis (the sphere's test in 2D).
-    const glm::vec2 axis(cylinder.center.x, cylinder.center.z);
-    const glm::vec2 nearest = glm::clamp(axis, glm::vec2(box.lo.x, box.lo.z), glm::vec2(box.hi.x, box.hi.z));
-    const glm::vec2 d = axis - nearest;
-    const float reach = cylinder.radius + thickness;
-    const float scale = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(nearest.x), std::abs(nearest.y)});
-    const float grown = reach + margin(reach + 4.0f * scale);
-    return glm::dot(d, d) < grown * grown;
-}
-
-bool may_touch(const GroundCollider& ground, float thickness, const Box& box) {
-    if (box.empty()) return false;
-    const float top = ground.height + thickness;
-    return box.lo.y < top + margin(std::abs(top) + std::abs(box.lo.y));
 }
 
 Box union_of(const Box* boxes, std::size_t n) {

@@ -1,7 +1,5 @@
 #include "clothsim/colliders.hpp"
 
-#include "contact_geometry.hpp"
-
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -14,154 +12,6 @@
 
 namespace clothsim {
 namespace {
-
-// Continuous collision: where the straight path p0 -> p1 of a substep passed through the solid shape
-// (the sphere of radius r, the box itself, not the thickness shell around them) although both ends are
-// outside. A path that only grazes the shell (a particle sliding over the surface cuts a chord into it) is
-// not a pass. `t` is where the path enters the shell (radius r + thickness, the box grown by thickness) and
-// `normal` the shell's outward normal there.
-template <class T>
-struct SweptHit {
-    T t = T(0);
-    glm::vec<3, T> normal{T(0), T(1), T(0)};
-};
-
-// Smallest t in [0, 1] with |p0 + t d - c| = radius, if the segment reaches that sphere.
-template <class T>
-std::optional<T> enter_sphere(glm::vec<3, T> f, glm::vec<3, T> d, T radius) {
-    const T a = glm::dot(d, d);
-    if (!(a > T(0))) return std::nullopt;
-    const T b = glm::dot(f, d);
-    const T disc = b * b - a * (glm::dot(f, f) - radius * radius);
-    if (!(disc >= T(0))) return std::nullopt;
-    const T t = (-b - std::sqrt(disc)) / a;
-    if (!(t <= T(1)) || (-b + std::sqrt(disc)) / a < T(0)) return std::nullopt;
-    return std::max(t, T(0));
-}
-
-template <class T>
-std::optional<SweptHit<T>> swept_hit(const SphereCollider& sphere, glm::vec<3, T> p0, glm::vec<3, T> p1, T thickness) {
-    const glm::vec<3, T> f = p0 - glm::vec<3, T>(sphere.center), d = p1 - p0;
-    if (!enter_sphere(f, d, T(sphere.radius))) return std::nullopt;
-    SweptHit<T> hit;
-    hit.t = enter_sphere(f, d, T(sphere.radius) + thickness).value_or(T(0));
-    const glm::vec<3, T> at = f + hit.t * d;
-    const T length = glm::length(at);
-    if (length > T(1e-12f)) hit.normal = at / length;
-    return hit;
-}
-
-// Slab test against the box grown by `grow`: the entry t and the axis it enters through.
-template <class T>
-std::optional<std::pair<T, int>> enter_box(const CubeCollider& cube, glm::vec<3, T> p0, glm::vec<3, T> d, T grow) {
-    T near = T(0), far = T(1);
-    int axis = -1;
-    for (int a = 0; a < 3; ++a) {
-        const T lo = T(cube.center[a]) - T(0.5) * T(cube.size[a]) - grow;
-        const T hi = T(cube.center[a]) + T(0.5) * T(cube.size[a]) + grow;
-        if (d[a] == T(0)) {
-            if (p0[a] < lo || p0[a] > hi) return std::nullopt;
-            continue;
-        }
-        T t0 = (lo - p0[a]) / d[a], t1 = (hi - p0[a]) / d[a];
-        if (t0 > t1) std::swap(t0, t1);
-        if (t0 > near) {
-            near = t0;
-            axis = a;
-        }
-        far = std::min(far, t1);
-        if (!(near <= far)) return std::nullopt;
-    }
-    return std::pair<T, int>(near, axis);
-}
-
-template <class T>
-std::optional<SweptHit<T>> swept_hit(const CubeCollider& cube, glm::vec<3, T> p0, glm::vec<3, T> p1, T thickness) {
-    const glm::vec<3, T> d = p1 - p0;
-    if (!enter_box(cube, p0, d, T(0))) return std::nullopt;
-    const auto entry = enter_box(cube, p0, d, thickness);
-    SweptHit<T> hit;
-    if (!entry || entry->second < 0) return std::nullopt;  // started inside the shell: the depth test's case
-    hit.t = entry->first;
-    hit.normal = glm::vec<3, T>(T(0));
-    hit.normal[entry->second] = d[entry->second] > T(0) ? T(-1) : T(1);
-    return hit;
-}
-
-// The segment p0 -> p0 + d (p0 relative to the centre) against the cylinder grown by `grow` (radius + grow,
-// each face moved out by grow: flat, like the box's): the entry t and the surface it enters through, 0 a face,
-// 1 the side, -1 none (it starts inside). The intersection of the slab between the faces with the infinite
-// cylinder around the axis, each an interval of t.
-template <class T>
-std::optional<std::pair<T, int>> enter_cylinder(const CylinderCollider& cylinder, glm::vec<3, T> p0,
-                                                glm::vec<3, T> d, T grow) {
-    T near = T(0), far = T(1);
-    int surface = -1;
-    const T half = T(0.5) * T(cylinder.height) + grow;
-    if (d.y == T(0)) {
-        if (std::abs(p0.y) > half) return std::nullopt;
-    } else {
-        T t0 = (-half - p0.y) / d.y, t1 = (half - p0.y) / d.y;
-        if (t0 > t1) std::swap(t0, t1);
-        if (t0 > near) {
-            near = t0;
-            surface = 0;
-        }
-        far = std::min(far, t1);
-    }
-    const T radius = T(cylinder.radius) + grow;
-    const T a = d.x * d.x + d.z * d.z;
-    const T c = p0.x * p0.x + p0.z * p0.z - radius * radius;
-    if (!(a > T(0))) {
-        if (c > T(0)) return std::nullopt;  // moving along the axis, beside the cylinder
-    } else {
-        const T b = p0.x * d.x + p0.z * d.z;
-        const T disc = b * b - a * c;
-        if (!(disc >= T(0))) return std::nullopt;
-        const T root = std::sqrt(disc);
-        const T t0 = (-b - root) / a, t1 = (-b + root) / a;
-        if (t0 > near) {
-            near = t0;
-            surface = 1;
-        }
-        far = std::min(far, t1);
-    }
-    if (!(near <= far)) return std::nullopt;
-    return std::pair<T, int>(near, surface);
-}
-
-template <class T>
-std::optional<SweptHit<T>> swept_hit(const CylinderCollider& cylinder, glm::vec<3, T> p0, glm::vec<3, T> p1,
-                                     T thickness) {
-    using Vec = glm::vec<3, T>;
-    const Vec f = p0 - Vec(cylinder.center), d = p1 - p0;
-    if (!enter_cylinder(cylinder, f, d, T(0))) return std::nullopt;
-    const auto entry = enter_cylinder(cylinder, f, d, thickness);
-    if (!entry) return std::nullopt;
-    SweptHit<T> hit;
-    if (entry->second < 0) {
-        // Starts inside the flat-grown cylinder but outside the shell (collide_shape checked): beside a rim,
-        // where the shell is rounded. It stops where it is, its motion toward the rim removed.
-        hit.t = T(0);
-        hit.normal = contact(cylinder, p0, thickness).normal;
-        return hit;
-    }
-    hit.t = entry->first;
-    if (entry->second == 0) {
-        hit.normal = Vec(T(0), d.y > T(0) ? T(-1) : T(1), T(0));
-    } else {
-        const Vec at = f + hit.t * d;
-        const T r = std::sqrt(at.x * at.x + at.z * at.z);
-        hit.normal = r > T(1e-12f) ? Vec(at.x / r, T(0), at.z / r) : Vec(T(1), T(0), T(0));
-    }
-    return hit;
-}
-
-// The ground is a half-space: a path that ends below it ends in contact, so there is nothing to sweep.
-template <class T>
-std::optional<SweptHit<T>> swept_hit(const GroundCollider&, glm::vec<3, T>, glm::vec<3, T>, T) {
-    return std::nullopt;
-}
 
 // Returns a bound on how far it moved any particle: each push is at most depth (1 + friction) long (the normal
 // push plus a friction cut of at most friction x depth), or the way back to where a swept path entered. A NaN
@@ -217,8 +67,8 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
 
 // Returns the number of blocks tested: none, and no particle moved.
 template <class Shape>
-long long collide_blocks(State& state, const Shape& shape, float thickness, bool broad_phase, CollisionBlocks& blocks,
-                         const Box& cloth, int which, int threads, StepProfile* profile) {
+long long collide_blocks(State& state, const Shape& shape, float friction, float thickness, bool broad_phase,
+                         CollisionBlocks& blocks, const Box& cloth, std::size_t kind, int threads, StepProfile* profile) {
     // First the whole cloth (`cloth` holds it): a collider out of its reach costs this one test; then each
     // block's box.
     const bool whole_cloth = !broad_phase || may_touch(shape, thickness, cloth);
@@ -233,13 +83,12 @@ long long collide_blocks(State& state, const Shape& shape, float thickness, bool
     blocks.grown.assign(blocks.tested.size(), 0);
     // Blocks hold distinct particles: threads share them when there are enough to pay for the fork (four
     // times as many for the ground, whose test is a comparison), and the result is the same for any count.
-    const std::size_t enough = std::is_same_v<Shape, GroundCollider> ? 4 * kParallelCollisionParticles
-                                                                     : kParallelCollisionParticles;
+    const std::size_t enough = Shape::kHalfSpace ? 4 * kParallelCollisionParticles : kParallelCollisionParticles;
     const int team = threads > 1 && particles >= enough ? threads : 1;
     auto test = [&](long long t) {
         const std::size_t k = blocks.tested[t];
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
-        const float moved = static_cast<float>(collide_shape(state, shape, double(shape.friction), double(thickness), begin, end));
+        const float moved = static_cast<float>(collide_shape(state, shape, double(friction), double(thickness), begin, end));
         if (moved > 0.0f && broad_phase) {
             // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
             // conservative for the next collider, and O(1).
@@ -265,56 +114,51 @@ long long collide_blocks(State& state, const Shape& shape, float thickness, bool
         blocks.cloth.hi = glm::max(blocks.cloth.hi, box.hi);
     }
     if (profile) {
-        profile->blocks_tested[which] += tested;
-        profile->blocks_offered[which] += static_cast<long long>(blocks.count());
+        profile->blocks_tested[kind] += tested;
+        profile->blocks_offered[kind] += static_cast<long long>(blocks.count());
     }
     return tested;
 }
 
 }  // namespace
 
-float signed_distance(const SphereCollider& sphere, glm::vec3 p) {
-    return glm::length(p - sphere.center) - sphere.radius;
-}
-
-float signed_distance(const CubeCollider& cube, glm::vec3 p) {
-    const glm::vec3 q = glm::abs(p - cube.center) - 0.5f * cube.size;
-    return glm::length(glm::max(q, glm::vec3(0.0f))) + std::min(std::max({q.x, q.y, q.z}), 0.0f);
-}
-
-float signed_distance(const CylinderCollider& cylinder, glm::vec3 p) {
-    const glm::vec3 local = p - cylinder.center;
-    const glm::vec2 q(std::sqrt(local.x * local.x + local.z * local.z) - cylinder.radius,
-                      std::abs(local.y) - 0.5f * cylinder.height);
-    return glm::length(glm::max(q, glm::vec2(0.0f))) + std::min(std::max(q.x, q.y), 0.0f);
-}
-
-float signed_distance(const GroundCollider& ground, glm::vec3 p) { return p.y - ground.height; }
-
 void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin, std::size_t end) {
-    using T = double;
     end = std::min(end, state.size());
-    const T thickness = colliders.thickness;
-    if (colliders.sphere.enabled) collide_shape(state, colliders.sphere, T(colliders.sphere.friction), thickness, begin, end);
-    if (colliders.cube.enabled) collide_shape(state, colliders.cube, T(colliders.cube.friction), thickness, begin, end);
-    if (colliders.cylinder.enabled) collide_shape(state, colliders.cylinder, T(colliders.cylinder.friction), thickness, begin, end);
-    if (colliders.ground.enabled) collide_shape(state, colliders.ground, T(colliders.ground.friction), thickness, begin, end);
-}
-// Whether the sphere, the cube or the cylinder (those enabled) may touch a particle in `box`.
-bool shapes_may_touch(const ColliderSettings& colliders, const Box& box) {
-    const float t = colliders.thickness;
-    return (colliders.sphere.enabled && may_touch(colliders.sphere, t, box)) ||
-           (colliders.cube.enabled && may_touch(colliders.cube, t, box)) ||
-           (colliders.cylinder.enabled && may_touch(colliders.cylinder, t, box));
+    for (const Collider& c : colliders.shapes) {
+        if (c.enabled) collide(state, c, colliders.thickness, begin, end);
+    }
 }
 
-bool any_shape(const ColliderSettings& colliders) {
-    return colliders.sphere.enabled || colliders.cube.enabled || colliders.cylinder.enabled;
+void collide(State& state, const Collider& collider, float thickness, std::size_t begin, std::size_t end) {
+    std::visit([&](const auto& shape) {
+        collide_shape(state, shape, double(collider.friction), double(thickness), begin, std::min(end, state.size()));
+    }, collider.shape);
 }
+
+namespace {
+
+// Whether a solid shape (not a half-space) that is enabled may touch a particle in `box`.
+bool solids_may_touch(const ColliderSettings& colliders, const Box& box) {
+    return std::any_of(colliders.shapes.begin(), colliders.shapes.end(), [&](const Collider& c) {
+        return c.enabled && !is_half_space(c) && may_touch(c, colliders.thickness, box);
+    });
+}
+
+bool any_solid(const ColliderSettings& colliders) {
+    return std::any_of(colliders.shapes.begin(), colliders.shapes.end(),
+                       [](const Collider& c) { return c.enabled && !is_half_space(c); });
+}
+
+bool any_half_space(const ColliderSettings& colliders) {
+    return std::any_of(colliders.shapes.begin(), colliders.shapes.end(),
+                       [](const Collider& c) { return c.enabled && is_half_space(c); });
+}
+
+}  // namespace
 
 BlockBounds block_bounds_for(const ColliderSettings& colliders, const CollisionBlocks& blocks) {
-    if (!any_shape(colliders)) return BlockBounds::Lowest;
-    return blocks.carried_valid && !shapes_may_touch(colliders, blocks.carried()) ? BlockBounds::Lowest
+    if (!any_solid(colliders)) return BlockBounds::Lowest;
+    return blocks.carried_valid && !solids_may_touch(colliders, blocks.carried()) ? BlockBounds::Lowest
                                                                                    : BlockBounds::Box;
 }
 
@@ -325,9 +169,9 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
         blocks.current = blocks.boxes_current = false;
     }
     const std::size_t count = blocks.count();
-    const bool shapes = any_shape(colliders);
-    if (!shapes) blocks.carried_valid = false;  // grown only while a shape may need it
-    if (!shapes && !colliders.ground.enabled) return false;
+    const bool shapes = any_solid(colliders);
+    if (!shapes) blocks.carried_valid = false;  // grown only while a solid shape may need it
+    if (!shapes && !any_half_space(colliders)) return false;
     const auto finite = [](glm::dvec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     const bool known = motion && !motion->empty && finite(motion->lo) && finite(motion->hi);
     if (!broad_phase) {
@@ -347,7 +191,7 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
                     blocks.carried_hi += glm::max(motion->hi, glm::dvec3(0.0));
                 }
             }
-            if (!blocks.carried_valid || shapes_may_touch(colliders, blocks.carried())) {
+            if (!blocks.carried_valid || solids_may_touch(colliders, blocks.carried())) {
                 from_sweep = false;
                 blocks.bounds = BlockBounds::Box;
             }
@@ -381,25 +225,17 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     long long tested = 0;
     // With Lowest boxes the shapes meet only the carried box, which none of them can reach (checked above).
     const Box shape_cloth = blocks.bounds == BlockBounds::Lowest ? blocks.carried() : blocks.cloth;
-    if (colliders.sphere.enabled) {
-        StageTimer timer(profile, Stage::Sphere);
-        tested += collide_blocks(state, colliders.sphere, thickness, broad_phase, blocks, shape_cloth,
-                                 collider_index(Stage::Sphere), threads, profile);
-    }
-    if (colliders.cube.enabled) {
-        StageTimer timer(profile, Stage::Cube);
-        tested += collide_blocks(state, colliders.cube, thickness, broad_phase, blocks, shape_cloth,
-                                 collider_index(Stage::Cube), threads, profile);
-    }
-    if (colliders.cylinder.enabled) {
-        StageTimer timer(profile, Stage::Cylinder);
-        tested += collide_blocks(state, colliders.cylinder, thickness, broad_phase, blocks, shape_cloth,
-                                 collider_index(Stage::Cylinder), threads, profile);
-    }
-    if (colliders.ground.enabled) {
-        StageTimer timer(profile, Stage::Ground);
-        tested += collide_blocks(state, colliders.ground, thickness, broad_phase, blocks, blocks.cloth,
-                                 collider_index(Stage::Ground), threads, profile);
+    {
+        StageTimer timer(profile, Stage::Colliders);
+        for (const Collider& c : colliders.shapes) {
+            if (!c.enabled) continue;
+            // A half-space reads the blocks' lowest points, which every box holds.
+            const Box& cloth = is_half_space(c) ? blocks.cloth : shape_cloth;
+            tested += std::visit([&](const auto& shape) {
+                return collide_blocks(state, shape, c.friction, thickness, broad_phase, blocks, cloth, c.kind(), threads,
+                                      profile);
+            }, c.shape);
+        }
     }
     // Whole boxes (grown by any push) hold every particle: the carried box starts again from them. A push
     // under Lowest boxes may leave the carried box.
@@ -413,19 +249,5 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     }
     return tested > 0;
 }
-
-void collide(State& state, const SphereCollider& sphere, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, sphere, double(sphere.friction), double(thickness), begin, std::min(end, state.size()));
-}
-void collide(State& state, const CubeCollider& cube, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, cube, double(cube.friction), double(thickness), begin, std::min(end, state.size()));
-}
-void collide(State& state, const CylinderCollider& cylinder, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, cylinder, double(cylinder.friction), double(thickness), begin, std::min(end, state.size()));
-}
-void collide(State& state, const GroundCollider& ground, float thickness, std::size_t begin, std::size_t end) {
-    collide_shape(state, ground, double(ground.friction), double(thickness), begin, std::min(end, state.size()));
-}
-
 
 }  // namespace clothsim

@@ -273,7 +273,7 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
         if (grab_) grab_external_.add(grab_->particle, grab_force(state_));
         external = &grab_external_;
     }
-    const bool boxes = plan_.any_collider() && settings_.solver.broad_phase;
+    const bool boxes = plan_.colliders && settings_.solver.broad_phase;
     if (boxes) blocks_.bounds = block_bounds_for(settings_.colliders, blocks_);
     {
         StageTimer timer(profile, Stage::Fast);
@@ -320,7 +320,7 @@ std::size_t MassSpring::apply_tethers() {
 // The same split for the boxes of the collision broad phase's blocks (block_starts' grid layout, row by
 // row), which the collision stage would otherwise make again block by block on one thread.
 bool MassSpring::box_blocks_on_team(StepProfile* profile) {
-    if (plan_.path != StepPath::Fast || !fast_.solver || !plan_.any_collider() || !settings_.solver.broad_phase) {
+    if (plan_.path != StepPath::Fast || !fast_.solver || !plan_.colliders || !settings_.solver.broad_phase) {
         return false;
     }
     StageTimer timer(profile, Stage::BroadPhase);
@@ -339,12 +339,12 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile) {
 }
 
 bool MassSpring::sweep_takes_motion_bounds() const {
-    const bool swept_boxes = settings_.solver.broad_phase && (plan_.sphere || plan_.cube || plan_.cylinder);
+    const bool swept_boxes = settings_.solver.broad_phase && plan_.solids;
     return plan_.self_collision || swept_boxes;
 }
 
 bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
-    if (!plan_.any_collider()) {
+    if (!plan_.colliders) {
         blocks_.carried_valid = false;  // not grown while no stage reads it
         return false;
     }
@@ -890,24 +890,20 @@ void scene_bounds(const MassSpring& sim, glm::vec3& lo, glm::vec3& hi) {
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
     }
+    // The solid shapes' boxes, then the planes' heights (unbounded sideways, they bound only y).
     const ColliderSettings& c = sim.settings().colliders;
-    if (c.sphere.enabled) {
-        lo = glm::min(lo, c.sphere.center - glm::vec3(c.sphere.radius));
-        hi = glm::max(hi, c.sphere.center + glm::vec3(c.sphere.radius));
-    }
-    if (c.cube.enabled) {
-        lo = glm::min(lo, c.cube.center - 0.5f * c.cube.size);
-        hi = glm::max(hi, c.cube.center + 0.5f * c.cube.size);
-    }
-    if (c.cylinder.enabled) {
-        const glm::vec3 half(c.cylinder.radius, 0.5f * c.cylinder.height, c.cylinder.radius);
-        lo = glm::min(lo, c.cylinder.center - half);
-        hi = glm::max(hi, c.cylinder.center + half);
+    for (const Collider& collider : c.shapes) {
+        if (!collider.enabled || is_half_space(collider)) continue;
+        const Box box = bounds(collider);
+        lo = glm::min(lo, box.lo);
+        hi = glm::max(hi, box.hi);
     }
     if (!(lo.x <= hi.x)) lo = hi = glm::vec3(0.0f);
-    if (c.ground.enabled) {
-        lo.y = std::min(lo.y, c.ground.height);
-        hi.y = std::max(hi.y, c.ground.height);
+    for (const Collider& collider : c.shapes) {
+        if (!collider.enabled || !is_half_space(collider)) continue;
+        const Box box = bounds(collider);
+        lo.y = std::min(lo.y, box.lo.y);
+        hi.y = std::max(hi.y, box.hi.y);
     }
 }
 

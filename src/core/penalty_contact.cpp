@@ -1,28 +1,22 @@
 #include "penalty_contact.hpp"
 
-#include "contact_geometry.hpp"
+#include "clothsim/collider.hpp"
 
 #include <glm/geometric.hpp>
+
+#include <algorithm>
 
 namespace clothsim {
 namespace {
 
-// Calls visit(contact) for each enabled collider the particle at p touches (depth > 0), sphere, cube,
-// cylinder, ground in that order.
+// Calls visit(contact) for each enabled collider the particle at p touches (depth > 0), in the list's order.
 template <class Visit>
 void for_each_contact(const ColliderSettings& colliders, glm::dvec3 p, Visit visit) {
     const double t = colliders.thickness;
-    if (colliders.sphere.enabled) {
-        if (const Contact<double> c = contact(colliders.sphere, p, t); c.depth > 0.0) visit(c);
-    }
-    if (colliders.cube.enabled) {
-        if (const Contact<double> c = contact(colliders.cube, p, t); c.depth > 0.0) visit(c);
-    }
-    if (colliders.cylinder.enabled) {
-        if (const Contact<double> c = contact(colliders.cylinder, p, t); c.depth > 0.0) visit(c);
-    }
-    if (colliders.ground.enabled) {
-        if (const Contact<double> c = contact(colliders.ground, p, t); c.depth > 0.0) visit(c);
+    for (const Collider& collider : colliders.shapes) {
+        if (!collider.enabled) continue;
+        const Contact<double> c = std::visit([&](const auto& shape) { return contact(shape, p, t); }, collider.shape);
+        if (c.depth > 0.0) visit(c);
     }
 }
 
@@ -64,9 +58,9 @@ double contact_potential_energy(const State& state, const ColliderSettings& coll
 }
 
 double contact_stiffness_bound(const ColliderSettings& colliders) {
-    const int enabled = int(colliders.sphere.enabled) + int(colliders.cube.enabled) + int(colliders.cylinder.enabled) +
-                        int(colliders.ground.enabled);
-    return 3.0 * double(colliders.contact_stiffness) * enabled;
+    const auto enabled = std::count_if(colliders.shapes.begin(), colliders.shapes.end(),
+                                       [](const Collider& c) { return c.enabled; });
+    return 3.0 * double(colliders.contact_stiffness) * double(enabled);
 }
 
 }  // namespace clothsim

@@ -1,6 +1,6 @@
 // Penalty contact (colliders.contact = penalty): each enabled collider pushes each free particle at depth
 // p > 0 (thickness minus its distance to the surface, the same depth the projection uses:
-// contact_geometry.hpp) along the surface normal with
+// shapes/shape.hpp) along the surface normal with
 //
 //   F = k_c p^3 / t^2,   potential U = k_c p^4 / (4 t^2),   stiffness dF/dp = 3 k_c p^2 / t^2,
 //

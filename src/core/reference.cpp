@@ -47,7 +47,7 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
     const BasicDynamics<double> dynamics{forces, forces, settings.forces.gravity, settings.springs.damping};
     for (long long s = 0; s < steps; ++s) {
         step_rk4(state, dynamics, h);
-        if (plan.any_collider()) collide_all(state, settings.colliders);
+        if (plan.colliders) collide_all(state, settings.colliders);
         state.time += h;
     }
     std::vector<glm::dvec3> out(n);

@@ -61,22 +61,6 @@ const std::array kFields = {
 
     FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest; the table's radius makes each preset pin a clip; clip = \"soft\" holds a clip's particles by springs that fade to 0 at its rim instead of pinning them (the load enters the cloth smoothly)", [](Scene& s) -> FieldRef { return &s.pins; }},
 
-    FieldInfo{"colliders.sphere.enabled", "", 0, 0, "collide with the sphere", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.enabled; }},
-    FieldInfo{"colliders.sphere.center", "m", -kBig, kBig, "sphere centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.center; }},
-    FieldInfo{"colliders.sphere.radius", "m", 0, kBig, "sphere radius", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.radius; }},
-    FieldInfo{"colliders.sphere.friction", "", 0, 10, "Coulomb friction coefficient (0 = frictionless)", [](Scene& s) -> FieldRef { return &s.settings.colliders.sphere.friction; }},
-    FieldInfo{"colliders.cube.enabled", "", 0, 0, "collide with the axis-aligned cube (box)", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.enabled; }},
-    FieldInfo{"colliders.cube.center", "m", -kBig, kBig, "box centre", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.center; }},
-    FieldInfo{"colliders.cube.size", "m", 0, kBig, "box edge lengths along x, y, z", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.size; }},
-    FieldInfo{"colliders.cube.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.cube.friction; }},
-    FieldInfo{"colliders.cylinder.enabled", "", 0, 0, "collide with the solid cylinder, axis along y (e.g. a Cusick drape tester's support disc)", [](Scene& s) -> FieldRef { return &s.settings.colliders.cylinder.enabled; }},
-    FieldInfo{"colliders.cylinder.center", "m", -kBig, kBig, "cylinder centre: the middle of its axis (top face at y + height / 2)", [](Scene& s) -> FieldRef { return &s.settings.colliders.cylinder.center; }},
-    FieldInfo{"colliders.cylinder.radius", "m", 0, kBig, "cylinder radius (a Cusick support disc: 0.09)", [](Scene& s) -> FieldRef { return &s.settings.colliders.cylinder.radius; }},
-    FieldInfo{"colliders.cylinder.height", "m", 0, kBig, "cylinder height, bottom face to top face", [](Scene& s) -> FieldRef { return &s.settings.colliders.cylinder.height; }},
-    FieldInfo{"colliders.cylinder.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.cylinder.friction; }},
-    FieldInfo{"colliders.ground.enabled", "", 0, 0, "collide with the ground plane y = height", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.enabled; }},
-    FieldInfo{"colliders.ground.height", "m", -kBig, kBig, "ground height", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.height; }},
-    FieldInfo{"colliders.ground.friction", "", 0, 10, "Coulomb friction coefficient", [](Scene& s) -> FieldRef { return &s.settings.colliders.ground.friction; }},
     FieldInfo{"colliders.thickness", "m", 0, 1, "distance particles keep from every collider surface", [](Scene& s) -> FieldRef { return &s.settings.colliders.thickness; }},
     FieldInfo{"colliders.contact", "", 0, 0, "projection: particles are moved out of the thickness shell after each substep, with Coulomb friction and continuous collision; penalty: a smooth force contact_stiffness x depth^3 / thickness^2 pushes them out (frictionless: friction is ignored; no continuous collision; thickness > 0)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact; }},
     FieldInfo{"colliders.contact_stiffness", "N/m", 1, 1e9, "penalty contact's k_c: the push at depth = thickness is k_c x thickness (unused by projection)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact_stiffness; }},
@@ -127,7 +111,6 @@ std::string cat(const Parts&... parts) {
     return s;
 }
 
-std::string range(const FieldInfo& f) { return cat("[", number(f.min), ", ", number(f.max), "]"); }
 
 }  // namespace
 
@@ -150,9 +133,12 @@ std::span<const std::string_view> cloth_shape_names() { return kClothShapeNames;
 
 std::string describe_pin_radius() { return cat("a number in [0.0, ", number(kMaxPinRadius), "] m"); }
 
-std::string describe_allowed(const FieldInfo& field) {
-    Scene scratch;
-    const std::string unit = field.unit.empty() ? "" : cat(" ", field.unit);
+namespace {
+
+// A field's allowed values from its unit, range and type (the reference's alternative).
+std::string describe_allowed_as(std::string_view unit_name, double min, double max, FieldRef sample) {
+    const std::string unit = unit_name.empty() ? "" : cat(" ", unit_name);
+    const std::string bounds = cat("[", number(min), ", ", number(max), "]");
     auto join = [](std::span<const std::string_view> names) {
         std::string s;
         for (std::size_t i = 0; i < names.size(); ++i) s += cat(i ? ", " : "", names[i]);
@@ -160,11 +146,11 @@ std::string describe_allowed(const FieldInfo& field) {
     };
     return std::visit(
         Overloaded{
-            [&](int*) { return cat("an integer in [", std::to_string(int(field.min)), ", ", std::to_string(int(field.max)), "]"); },
-            [&](float*) { return cat("a number in ", range(field), unit); },
+            [&](int*) { return cat("an integer in [", std::to_string(int(min)), ", ", std::to_string(int(max)), "]"); },
+            [&](float*) { return cat("a number in ", bounds, unit); },
             [&](bool*) { return std::string("true or false"); },
-            [&](glm::vec2*) { return cat("one number or [x, y], each in ", range(field), unit); },
-            [&](glm::vec3*) { return cat("[x, y, z], each in ", range(field), unit); },
+            [&](glm::vec2*) { return cat("one number or [x, y], each in ", bounds, unit); },
+            [&](glm::vec3*) { return cat("[x, y, z], each in ", bounds, unit); },
             [&](std::string*) { return std::string("a string"); },
             [&](PinSpec*) {
                 return cat("one of ", join(kPinPresetNames),
@@ -174,7 +160,14 @@ std::string describe_allowed(const FieldInfo& field) {
             },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return "one of " + join(names_of(v)); },
         },
-        field.ref(scratch));
+        sample);
+}
+
+}  // namespace
+
+std::string describe_allowed(const FieldInfo& field) {
+    Scene scratch;
+    return describe_allowed_as(field.unit, field.min, field.max, field.ref(scratch));
 }
 
 ConstFieldRef FieldInfo::read(const Scene& scene) const {
@@ -194,7 +187,10 @@ void copy_field(const FieldInfo& field, const Scene& from, Scene& to) {
     }, field.ref(to));
 }
 
-std::string format_value(const Scene& scene, const FieldInfo& field) {
+namespace {
+
+// A value as TOML text.
+std::string format_ref(ConstFieldRef value) {
     // A TOML basic string: quotes, backslashes and control characters escaped (TOML 1.0, "String").
     auto quoted = [](std::string_view text) {
         std::string out = "\"";
@@ -239,8 +235,13 @@ std::string format_value(const Scene& scene, const FieldInfo& field) {
             },
             [&]<class Enum>(const Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
         },
-        field.read(scene));
+        value);
 }
+
+}  // namespace
+
+std::string format_value(const Scene& scene, const FieldInfo& field) { return format_ref(field.read(scene)); }
+
 
 void validate(const Scene& scene) {
     for (const FieldInfo& f : kFields) {
@@ -288,6 +289,24 @@ void validate(const Scene& scene) {
         throw SceneError("colliders.thickness = " + format_value(scene, *find_field("colliders.thickness")) +
                          " leaves penalty contact no shell to push in; allowed with colliders.contact = \"penalty\": "
                          "a thickness in (0.0, 1.0] m");
+    }
+    for (std::size_t i = 0; i < colliders.shapes.size(); ++i) {
+        Collider collider = colliders.shapes[i];
+        for (const ColliderField& f : collider_fields(collider)) {
+            auto in_range = [&](float v) {
+                return std::isfinite(v) && v >= static_cast<float>(f.min) && v <= static_cast<float>(f.max);
+            };
+            const bool ok = std::visit(Overloaded{
+                                           [&](const float* v) { return in_range(*v); },
+                                           [&](const glm::vec3* v) { return in_range(v->x) && in_range(v->y) && in_range(v->z); },
+                                           [&](const auto*) { return true; },
+                                       },
+                                       f.ref);
+            if (!ok) {
+                throw SceneError(cat("colliders.shapes[", std::to_string(i), "] (", kind_name(collider), "): ", f.name,
+                                     " = ", format_value(f), " is out of range; allowed: ", describe_allowed(f)));
+            }
+        }
     }
     auto check_radius = [&](float radius, const std::string& what) {
         if (!(radius >= 0.0f && radius <= static_cast<float>(kMaxPinRadius))) {
@@ -338,6 +357,66 @@ std::optional<std::string> clamp_to_range(Scene& scene, const FieldInfo& f) {
     if (!clamped) return std::nullopt;
     return std::string(f.name) + " = " + before + " is out of range; allowed: " + describe_allowed(f) + "; set to " +
            format_value(scene, f);
+}
+
+std::vector<ColliderField> collider_fields(Collider& collider) {
+    std::vector<ColliderField> rows = {
+        {"enabled", "", 0, 0, "collide with it (false keeps it in the scene, without contact)", &collider.enabled},
+        {"friction", "", 0, 10, "Coulomb friction coefficient (0 = frictionless)", &collider.friction},
+    };
+    std::visit([&]<class Shape>(Shape& shape) {
+        for (const ShapeField<Shape>& f : Shape::kFields) {
+            rows.push_back({f.name, f.unit, f.min, f.max, f.help,
+                            std::visit([](auto* v) -> FieldRef { return v; }, f.ref(shape))});
+        }
+    }, collider.shape);
+    return rows;
+}
+
+std::vector<ColliderField> collider_fields_of_kind(std::size_t kind) {
+    // The rows' names, units, ranges and help are static; only their references would point at the scratch.
+    thread_local Collider scratch;
+    scratch = default_collider(kind);
+    return collider_fields(scratch);
+}
+
+std::string describe_allowed(const ColliderField& field) {
+    return describe_allowed_as(field.unit, field.min, field.max, field.ref);
+}
+
+std::string format_value(const ColliderField& field) {
+    return format_ref(std::visit([](auto* v) -> ConstFieldRef { return v; }, field.ref));
+}
+
+int find_collider_kind(std::string_view name) {
+    if (name == "cube") name = "box";
+    if (name == "ground") name = "plane";
+    const auto names = collider_kind_names();
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (names[i] == name) return static_cast<int>(i);
+    }
+    return -1;
+}
+
+Collider& first_form_collider(ColliderSettings& colliders, std::string_view section) {
+    const auto rank = [](std::size_t kind) {
+        const auto order = kFirstFormSections;
+        for (std::size_t r = 0; r < order.size(); ++r) {
+            if (static_cast<int>(kind) == find_collider_kind(order[r])) return r;
+        }
+        return order.size();
+    };
+    const int kind = find_collider_kind(section);
+    std::vector<Collider>& list = colliders.shapes;
+    for (Collider& c : list) {
+        if (static_cast<int>(c.kind()) == kind) return c;
+    }
+    // Before the first collider of a kind the first form resolved later, so an old file keeps its order.
+    auto at = std::find_if(list.begin(), list.end(),
+                           [&](const Collider& c) { return rank(c.kind()) > rank(static_cast<std::size_t>(kind)); });
+    Collider added = default_collider(static_cast<std::size_t>(kind));
+    added.enabled = false;
+    return *list.insert(at, added);
 }
 
 }  // namespace clothsim

@@ -250,8 +250,8 @@ std::optional<PinSpec> pins_of(const toml::node& node, Rejection& rejection) {
 
 // Sets one field from a TOML node. Returns false (and leaves the scene alone) when the node's type or
 // value is not allowed, saying why in `rejection` where it can; validate() checks cross-field rules afterwards.
-bool assign(Scene& scene, const FieldInfo& field, const toml::node& node, Rejection& rejection) {
-    auto in_range = [&](double v) { return std::isfinite(v) && v >= field.min && v <= field.max; };
+bool assign_to(FieldRef target_ref, double min, double max, const toml::node& node, Rejection& rejection) {
+    auto in_range = [&](double v) { return std::isfinite(v) && v >= min && v <= max; };
     return std::visit(
         Overloaded{
             [&](int* target) {
@@ -308,7 +308,11 @@ bool assign(Scene& scene, const FieldInfo& field, const toml::node& node, Reject
                 return true;
             },
         },
-        field.ref(scene));
+        target_ref);
+}
+
+bool assign(Scene& scene, const FieldInfo& field, const toml::node& node, Rejection& rejection) {
+    return assign_to(field.ref(scene), field.min, field.max, node, rejection);
 }
 
 // Well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF), as TOML requires.
@@ -364,9 +368,81 @@ std::string fields_in(std::string_view section) {
     return list;
 }
 
+std::string kind_list() {
+    std::string list;
+    for (std::string_view k : collider_kind_names()) list += (list.empty() ? "" : ", ") + std::string(k);
+    return list;
+}
+
+std::string collider_field_names(Collider& collider) {
+    std::string list;
+    for (const ColliderField& f : collider_fields(collider)) list += (list.empty() ? "" : ", ") + std::string(f.name);
+    return list;
+}
+
+// The fields of one collider from a table (a [[colliders.shapes]] entry or a first-form section), `name` its
+// dotted name in messages. `kind` is read by the caller.
+void load_collider(Collider& collider, const toml::table& table, const std::string& name, std::string_view source) {
+    for (auto&& [key, node] : table) {
+        if (key.str() == "kind") continue;
+        const std::string field_name = name + "." + std::string(key.str());
+        const auto rows = collider_fields(collider);
+        const auto row = std::find_if(rows.begin(), rows.end(), [&](const ColliderField& f) { return f.name == key.str(); });
+        if (row == rows.end()) {
+            throw SceneError(where(source, node) + ": unknown field '" + field_name + "'; known fields of a " +
+                             std::string(kind_name(collider)) + ": " + collider_field_names(collider));
+        }
+        if (Rejection rejection; !assign_to(row->ref, row->min, row->max, node, rejection)) {
+            throw SceneError(where(source, node) + ": " + field_name + " = " + show(node) +
+                             " is not allowed; allowed: " + describe_allowed(*row));
+        }
+    }
+}
+
+// colliders.shapes: an array of tables ([[colliders.shapes]]), each with a `kind`. It replaces the list (the
+// default ground included): the scene holds exactly the shapes it names.
+void load_shapes(Scene& scene, const toml::node& node, std::string_view source) {
+    const toml::array* array = node.as_array();
+    if (!array || !array->is_array_of_tables()) {
+        throw SceneError(where(source, node) + ": colliders.shapes is a list of tables ([[colliders.shapes]] entries, "
+                                               "each with kind = " + kind_list() + ")");
+    }
+    std::vector<Collider> shapes;
+    for (std::size_t i = 0; i < array->size(); ++i) {
+        const toml::table& entry = *array->get(i)->as_table();
+        const std::string name = "colliders.shapes[" + std::to_string(i) + "]";
+        const auto kind = entry["kind"].value<std::string>();
+        const int index = kind ? find_collider_kind(*kind) : -1;
+        if (index < 0) {
+            const toml::node& at = entry.contains("kind") ? *entry.get("kind") : static_cast<const toml::node&>(entry);
+            throw SceneError(where(source, at) + ": " + name + ".kind " +
+                             (kind ? "= \"" + *kind + "\" is not a collider kind" : std::string("is missing")) +
+                             "; allowed: one of " + kind_list());
+        }
+        shapes.push_back(default_collider(static_cast<std::size_t>(index)));
+        load_collider(shapes.back(), entry, name, source);
+    }
+    scene.settings.colliders.shapes = std::move(shapes);
+}
+
 void load_table(Scene& scene, const toml::table& table, const std::string& prefix, std::string_view source) {
+    if (prefix == "colliders") {
+        // The list first: the first form's sections then address its colliders (first_form_collider).
+        if (const toml::node* shapes = table.get("shapes")) load_shapes(scene, *shapes, source);
+    }
     for (auto&& [key, node] : table) {
         const std::string name = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+        if (prefix == "colliders" && key.str() == "shapes") continue;
+        if (prefix == "colliders" && std::find(kFirstFormSections.begin(), kFirstFormSections.end(), key.str()) !=
+                                         kFirstFormSections.end()) {
+            const toml::table* sub = node.as_table();
+            if (!sub) {
+                throw SceneError(where(source, node) + ": " + name + " is a section, not a value; its fields: " +
+                                 collider_field_names(first_form_collider(scene.settings.colliders, key.str())));
+            }
+            load_collider(first_form_collider(scene.settings.colliders, key.str()), *sub, name, source);
+            continue;
+        }
         if (const FieldInfo* field = find_field(name)) {
             if (Rejection rejection; !assign(scene, *field, node, rejection)) {
                 throw SceneError(where(source, rejection.at ? *rejection.at : node) + ": " + name + " = " + show(node) +
@@ -385,7 +461,8 @@ void load_table(Scene& scene, const toml::table& table, const std::string& prefi
         } else {
             throw SceneError(where(source, node) + ": unknown field '" + name + "'; known " +
                              (prefix.empty() ? std::string("top-level names") : "fields of [" + prefix + "]") + ": " +
-                             fields_in(prefix));
+                             fields_in(prefix) +
+                             (prefix == "colliders" ? ", shapes, sphere, cube, cylinder, ground" : ""));
         }
     }
 }
@@ -482,14 +559,52 @@ void apply_override(Scene& scene, std::string_view assignment) {
     if (text.find_first_of("\r\n") != std::string::npos) {
         throw SceneError(source + ": the value spans lines; give one field per --set");
     }
-    const FieldInfo* field = find_field(key);
-    if (!field) {
+    // A collider's field: colliders.shapes.N.field (N from 0, in the list's order) or a first-form name
+    // (colliders.sphere.radius: the first sphere, added switched off when there is none).
+    Scene candidate = scene;
+    std::optional<ColliderField> collider_field;
+    if (key.starts_with("colliders.")) {
+        const std::string rest = key.substr(std::string_view("colliders.").size());
+        const auto dot = rest.find('.');
+        const std::string head = rest.substr(0, dot), tail = dot == std::string::npos ? "" : rest.substr(dot + 1);
+        Collider* collider = nullptr;
+        std::string field_name = tail;
+        std::vector<Collider>& list = candidate.settings.colliders.shapes;
+        if (head == "shapes") {
+            const auto dot2 = tail.find('.');
+            const std::string index_text = tail.substr(0, dot2);
+            field_name = dot2 == std::string::npos ? "" : tail.substr(dot2 + 1);
+            std::size_t index = 0;
+            const auto parsed_index = std::from_chars(index_text.data(), index_text.data() + index_text.size(), index);
+            if (parsed_index.ec != std::errc() || parsed_index.ptr != index_text.data() + index_text.size() ||
+                index >= list.size()) {
+                throw SceneError(source + ": " + key + " names no collider; allowed: colliders.shapes.N.<field> with N in [0, " +
+                                 std::to_string(list.size()) + ") (the scene has " + std::to_string(list.size()) +
+                                 (list.size() == 1 ? " collider)" : " colliders)"));
+            }
+            collider = &list[index];
+        } else if (std::find(kFirstFormSections.begin(), kFirstFormSections.end(), head) != kFirstFormSections.end()) {
+            collider = &first_form_collider(candidate.settings.colliders, head);
+        }
+        if (collider) {
+            for (const ColliderField& f : collider_fields(*collider)) {
+                if (f.name == field_name) collider_field = f;
+            }
+            if (!collider_field) {
+                throw SceneError(source + ": unknown field '" + key + "'; known fields of a " +
+                                 std::string(kind_name(*collider)) + ": " + collider_field_names(*collider));
+            }
+        }
+    }
+    const FieldInfo* field = collider_field ? nullptr : find_field(key);
+    if (!field && !collider_field) {
         throw SceneError(source + ": unknown field '" + key + "'; fields: " + [] {
             std::string all;
             for (const FieldInfo& f : scene_fields()) all += (all.empty() ? "" : ", ") + std::string(f.name);
-            return all;
+            return all + ", colliders.shapes.N.<field>, colliders.sphere|cube|cylinder|ground.<field>";
         }());
     }
+    const std::string allowed = field ? describe_allowed(*field) : describe_allowed(*collider_field);
     // The value is TOML when it parses as one; otherwise it is taken as a bare string (top-row, uniform).
     std::optional<toml::table> parsed;
     try {
@@ -498,17 +613,19 @@ void apply_override(Scene& scene, std::string_view assignment) {
     }
     // A bare word is stored as it is and written back by to_toml(): it must be text a scene file can hold.
     if (!parsed && !valid_utf8(text)) {
-        throw SceneError(source + ": the value is not valid UTF-8; allowed: " + describe_allowed(*field));
+        throw SceneError(source + ": the value is not valid UTF-8; allowed: " + allowed);
     }
     const toml::value<std::string> bare(text);
     const toml::node& node = parsed && parsed->contains("value") ? *parsed->get("value")
                                                                     : static_cast<const toml::node&>(bare);
-    Scene candidate = scene;
-    if (Rejection rejection; !assign(candidate, *field, node, rejection)) {
+    Rejection rejection;
+    const bool assigned = field ? assign(candidate, *field, node, rejection)
+                                : assign_to(collider_field->ref, collider_field->min, collider_field->max, node, rejection);
+    if (!assigned) {
         throw SceneError(source + ": " + key + " = " + show(node) + " is not allowed" +
-                         (rejection.why.empty() ? "; allowed: " + describe_allowed(*field) : ": " + rejection.why));
+                         (rejection.why.empty() ? "; allowed: " + allowed : ": " + rejection.why));
     }
-    note_field_set(candidate, key);
+    if (field) note_field_set(candidate, key);
     try {
         validate(candidate);
         derive_springs(candidate);
@@ -519,7 +636,7 @@ void apply_override(Scene& scene, std::string_view assignment) {
 }
 
 std::string to_toml(const Scene& scene) {
-    std::string out = "# clothsim scene (fields, units and ranges: README.md, \"Scene files\")\n";
+    std::string out = "# clothsim scene (fields, units and ranges: docs/SCENE_FILES.md)\n";
     if (scene.material.enabled && scene.cloth.rows > 1 && scene.cloth.cols > 1) {
         if (const std::string note = spring_constants(scene.cloth, scene.material).note; !note.empty()) {
             out += "# material: " + note + "\n";
@@ -547,6 +664,11 @@ std::string to_toml(const Scene& scene) {
             out += "\n[" + section + "]\n";
         }
         out += text;
+    }
+    // The colliders, one [[colliders.shapes]] entry each, every field written.
+    for (Collider collider : scene.settings.colliders.shapes) {
+        out += "\n[[colliders.shapes]]\nkind = \"" + std::string(kind_name(collider)) + "\"\n";
+        for (const ColliderField& f : collider_fields(collider)) out += std::string(f.name) + " = " + format_value(f) + "\n";
     }
     return out;
 }

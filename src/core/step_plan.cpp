@@ -1,5 +1,7 @@
 #include "clothsim/step_plan.hpp"
 
+#include <algorithm>
+#include <array>
 #include <initializer_list>
 #include <utility>
 
@@ -14,10 +16,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Fast: return "fast solver";
         case Stage::Integrate: return "integrate";
         case Stage::BroadPhase: return "broad phase";
-        case Stage::Sphere: return "sphere";
-        case Stage::Cube: return "cube";
-        case Stage::Cylinder: return "cylinder";
-        case Stage::Ground: return "ground";
+        case Stage::Colliders: return "colliders";
         case Stage::SelfCollision: return "self collision";
         case Stage::Tethers: return "tethers";
         case Stage::StrainLimit: return "strain limit";
@@ -34,7 +33,7 @@ void StepProfile::add(const StepProfile& other) {
         ms[i] += other.ms[i];
         runs[i] += other.runs[i];
     }
-    for (std::size_t i = 0; i < kColliderCount; ++i) {
+    for (std::size_t i = 0; i < kColliderKindCount; ++i) {
         blocks_tested[i] += other.blocks_tested[i];
         blocks_offered[i] += other.blocks_offered[i];
     }
@@ -66,14 +65,13 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     plan.wind = wind_active(settings.forces);
     plan.holds = !topology.holds.empty();
     const ColliderSettings& c = settings.colliders;
-    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.cylinder.enabled || c.ground.enabled;
+    const bool any_enabled = std::any_of(c.shapes.begin(), c.shapes.end(), [](const Collider& s) { return s.enabled; });
     if (c.contact == ContactModel::Penalty) {
         plan.contact = any_enabled && c.thickness > 0.0f;  // no shell, no force (penalty_contact.hpp)
     } else {
-        plan.sphere = c.sphere.enabled;
-        plan.cube = c.cube.enabled;
-        plan.cylinder = c.cylinder.enabled;
-        plan.ground = c.ground.enabled;
+        plan.colliders = any_enabled;
+        plan.solids = std::any_of(c.shapes.begin(), c.shapes.end(),
+                                  [](const Collider& s) { return s.enabled && !is_half_space(s); });
     }
     plan.tethers = settings.springs.tether_strain > 0.0f && tethers;
     plan.strain_limit = settings.springs.strain_limit > 0.0f;
@@ -85,6 +83,21 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
 }
 
 namespace {
+
+// The enabled colliders' kinds, with a count where a kind repeats: "2 spheres, box, plane".
+std::string enabled_shapes(const ColliderSettings& colliders) {
+    std::array<int, kColliderKindCount> count{};
+    for (const Collider& c : colliders.shapes) count[c.kind()] += c.enabled ? 1 : 0;
+    std::string out;
+    for (std::size_t kind = 0; kind < kColliderKindCount; ++kind) {
+        if (count[kind] == 0) continue;
+        out.append(out.empty() ? "" : ", ");
+        if (count[kind] > 1) out.append(std::to_string(count[kind])).append(" ");
+        out.append(collider_kind_names()[kind]);
+        if (count[kind] > 1) out.append(collider_kind_names()[kind].ends_with('x') ? "es" : "s");
+    }
+    return out;
+}
 
 std::string spring_note(const StepPlan& plan, const Topology& topology) {
     std::string runs, skipped;
@@ -135,13 +148,9 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     }
     const ColliderSettings& c = settings.colliders;
     const bool penalty = c.contact == ContactModel::Penalty;
-    const bool any_enabled = c.sphere.enabled || c.cube.enabled || c.cylinder.enabled || c.ground.enabled;
+    const bool any_enabled = std::any_of(c.shapes.begin(), c.shapes.end(), [](const Collider& s) { return s.enabled; });
+    const std::string which = enabled_shapes(c);
     if (plan.contact) {
-        std::string which;
-        for (const auto& [on, name] : {std::pair{c.sphere.enabled, "sphere"}, std::pair{c.cube.enabled, "cube"},
-                                       std::pair{c.cylinder.enabled, "cylinder"}, std::pair{c.ground.enabled, "ground"}}) {
-            if (on) which.append(which.empty() ? "" : ", ").append(name);
-        }
         out.push_back({Stage::Contact, velocity ? Fused : Runs,
                        velocity ? "in the integrate stage: " + which : "penalty forces of " + which});
     } else {
@@ -160,7 +169,7 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
                         : (velocity ? "the integrator is not verlet" : "solver.method is textbook (or the cloth is no grid)")});
     out.push_back({Stage::Integrate, fast ? Fused : Runs, fast ? "in the fast solver" : ""});
     const char* penalty_note = "colliders.contact is penalty (a force in the contact stage)";
-    if (!plan.any_collider()) {
+    if (!plan.colliders) {
         out.push_back({Stage::BroadPhase, Skipped, penalty && any_enabled ? penalty_note : "no collider is enabled"});
     } else if (!settings.solver.broad_phase) {
         out.push_back({Stage::BroadPhase, Skipped, "solver.broad_phase is false"});
@@ -168,13 +177,10 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
         out.push_back({Stage::BroadPhase, Runs, fast ? "the cloth's box (the fast solver boxes the blocks)" : "boxes of the blocks and the cloth"});
     }
     const char* culled = settings.solver.broad_phase ? "blocks whose box meets it" : "every particle (broad phase off)";
-    auto collider = [&](Stage stage, bool runs, bool enabled, const char* disabled) {
-        out.push_back({stage, when(runs, Skipped), runs ? culled : (enabled ? penalty_note : disabled)});
-    };
-    collider(Stage::Sphere, plan.sphere, c.sphere.enabled, "colliders.sphere.enabled is false");
-    collider(Stage::Cube, plan.cube, c.cube.enabled, "colliders.cube.enabled is false");
-    collider(Stage::Cylinder, plan.cylinder, c.cylinder.enabled, "colliders.cylinder.enabled is false");
-    collider(Stage::Ground, plan.ground, c.ground.enabled, "colliders.ground.enabled is false");
+    out.push_back({Stage::Colliders, when(plan.colliders, Skipped),
+                   plan.colliders ? which + ": " + culled
+                                  : (any_enabled ? penalty_note
+                                                 : (c.shapes.empty() ? "colliders.shapes is empty" : "no collider is enabled"))});
     out.push_back({Stage::SelfCollision, when(plan.self_collision, Skipped),
                    plan.self_collision ? "tiles boxed; pairs within the thickness pushed apart" : "collision.self is false"});
     out.push_back({Stage::Tethers, when(plan.tethers, Skipped),
@@ -194,10 +200,18 @@ std::string profile_note(const StageStatus& status, const StepProfile& profile) 
         return std::to_string(profile.self_tiles_active) + " of " + std::to_string(profile.self_tiles) +
                " tiles in the narrow phase, " + std::to_string(profile.self_contacts) + " contacts";
     }
-    const int c = collider_index(status.stage);
-    if (c < 0 || !status.runs() || profile.blocks_offered[c] == 0) return status.note;
-    return std::to_string(profile.blocks_tested[c]) + " of " + std::to_string(profile.blocks_offered[c]) +
-           " blocks tested";
+    if (status.stage != Stage::Colliders || !status.runs()) return status.note;
+    std::string note;
+    for (std::size_t kind = 0; kind < kColliderKindCount; ++kind) {
+        if (profile.blocks_offered[kind] == 0) continue;
+        note.append(note.empty() ? "" : ", ")
+            .append(collider_kind_names()[kind])
+            .append(" ")
+            .append(std::to_string(profile.blocks_tested[kind]))
+            .append(" of ")
+            .append(std::to_string(profile.blocks_offered[kind]));
+    }
+    return note.empty() ? status.note : note + " blocks tested";
 }
 
 }  // namespace clothsim

@@ -62,10 +62,9 @@ glm::vec4 kind_color(SpringKind kind) {
     return glm::vec4(1.0f);
 }
 
-// The unit cylinder mesh (meshes.hpp) placed and sized as the collider.
-glm::mat4 cylinder_model(const CylinderCollider& cylinder) {
-    return glm::scale(glm::translate(glm::mat4(1.0f), cylinder.center),
-                      glm::vec3(cylinder.radius, cylinder.height, cylinder.radius));
+// Where a collider's unit mesh (meshes.hpp) stands: scaled, then moved (shape.hpp's ShapeDrawing).
+glm::mat4 model_of(const ShapeDrawing& d) {
+    return glm::scale(glm::translate(glm::mat4(1.0f), d.center), d.scale);
 }
 
 }  // namespace
@@ -233,19 +232,22 @@ void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_
     shadow_.set("u_light_view_projection", light_view_projection);
     shadow_.set("u_model", glm::mat4(1.0f));
     if (!input.sim.topology().triangles.empty() || input.sim.surface().split()) cloth_->draw();
-    const ColliderSettings& c = input.sim.settings().colliders;
-    if (c.sphere.enabled) {
-        shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.sphere.center), glm::vec3(c.sphere.radius)));
-        sphere_.draw();
+    for (const Collider& collider : input.sim.settings().colliders.shapes) {
+        const ShapeDrawing d = drawing(collider);
+        if (!collider.enabled || d.mesh == UnitMesh::Plane) continue;  // the floor casts no shadow
+        shadow_.set("u_model", model_of(d));
+        mesh_of(d.mesh).draw();
     }
-    if (c.cube.enabled) {
-        shadow_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
-        cube_.draw();
+}
+
+const GpuMesh& Renderer::mesh_of(UnitMesh mesh) const {
+    switch (mesh) {
+        case UnitMesh::Sphere: return sphere_;
+        case UnitMesh::Cube: return cube_;
+        case UnitMesh::Cylinder: return cylinder_;
+        case UnitMesh::Plane: break;
     }
-    if (c.cylinder.enabled) {
-        shadow_.set("u_model", cylinder_model(c.cylinder));
-        cylinder_.draw();
-    }
+    return ground_;
 }
 
 void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projection,
@@ -262,7 +264,6 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
     glBindTexture(GL_TEXTURE_2D, shadow_depth_.get());
     glActiveTexture(GL_TEXTURE0);
 
-    const ColliderSettings& c = input.sim.settings().colliders;
     auto material = [&](glm::vec4 color, const gl::Texture* texture, glm::vec2 uv_scale, float specular, float shininess) {
         lit_.set("u_color", color);
         lit_.set("u_use_texture", texture ? 1 : 0);
@@ -273,34 +274,47 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
         lit_.set("u_grid", 0);
     };
 
-    // Ground: opaque when it collides, a faint grid when it does not.
-    material(c.ground.enabled ? glm::vec4(0.55f, 0.58f, 0.55f, 1.0f) : glm::vec4(0.55f, 0.58f, 0.55f, 0.35f), nullptr,
+    // The floor: each plane that collides, opaque; a faint grid at the first plane's height (or at 0) when none
+    // does.
+    const std::vector<Collider>& shapes = input.sim.settings().colliders.shapes;
+    std::vector<float> floors;
+    float faint = 0.0f;
+    bool faint_set = false;
+    for (const Collider& collider : shapes) {
+        const ShapeDrawing d = drawing(collider);
+        if (d.mesh != UnitMesh::Plane) continue;
+        if (collider.enabled) floors.push_back(d.center.y);
+        if (!faint_set) faint = d.center.y, faint_set = true;
+    }
+    const bool solid_floor = !floors.empty();
+    if (!solid_floor) floors.push_back(faint);
+    material(solid_floor ? glm::vec4(0.55f, 0.58f, 0.55f, 1.0f) : glm::vec4(0.55f, 0.58f, 0.55f, 0.35f), nullptr,
              glm::vec2(1.0f), 0.05f, 16.0f);
     lit_.set("u_grid", 1);
-    lit_.set("u_model", glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, c.ground.height, 0.0f)));
-    if (!c.ground.enabled) {
+    if (!solid_floor) {
         glEnable(GL_BLEND);
         glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
         glDepthMask(GL_FALSE);
     }
-    ground_.draw();
+    for (float height : floors) {
+        lit_.set("u_model", glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, height, 0.0f)));
+        ground_.draw();
+    }
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
 
-    if (c.sphere.enabled) {
-        material({0.25f, 0.45f, 0.85f, 1.0f}, nullptr, glm::vec2(1.0f), 0.5f, 48.0f);
-        lit_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.sphere.center), glm::vec3(c.sphere.radius)));
-        sphere_.draw();
-    }
-    if (c.cube.enabled) {
-        material(glm::vec4(1.0f), &crate_, glm::vec2(1.0f), 0.35f, 32.0f);
-        lit_.set("u_model", glm::scale(glm::translate(glm::mat4(1.0f), c.cube.center), c.cube.size));
-        cube_.draw();
-    }
-    if (c.cylinder.enabled) {
-        material({0.30f, 0.62f, 0.38f, 1.0f}, nullptr, glm::vec2(1.0f), 0.45f, 40.0f);
-        lit_.set("u_model", cylinder_model(c.cylinder));
-        cylinder_.draw();
+    // The solid shapes, each kind in its own look: a blue sphere, a crate, a green cylinder.
+    for (const Collider& collider : shapes) {
+        const ShapeDrawing d = drawing(collider);
+        if (!collider.enabled || d.mesh == UnitMesh::Plane) continue;
+        switch (d.mesh) {
+            case UnitMesh::Sphere: material({0.25f, 0.45f, 0.85f, 1.0f}, nullptr, glm::vec2(1.0f), 0.5f, 48.0f); break;
+            case UnitMesh::Cube: material(glm::vec4(1.0f), &crate_, glm::vec2(1.0f), 0.35f, 32.0f); break;
+            case UnitMesh::Cylinder: material({0.30f, 0.62f, 0.38f, 1.0f}, nullptr, glm::vec2(1.0f), 0.45f, 40.0f); break;
+            case UnitMesh::Plane: break;
+        }
+        lit_.set("u_model", model_of(d));
+        mesh_of(d.mesh).draw();
     }
     if (!input.view.wireframe && (!input.sim.topology().triangles.empty() || input.sim.surface().split())) {
         material(input.view.texture ? glm::vec4(1.0f) : glm::vec4(0.80f, 0.36f, 0.26f, 1.0f),

@@ -86,6 +86,7 @@ private:
     void draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection);
     void draw_lit(const RenderInput& input, const glm::mat4& view_projection, const glm::mat4& light_view_projection);
     void draw_debug(const RenderInput& input, const glm::mat4& view_projection);
+    const GpuMesh& mesh_of(UnitMesh mesh) const;  // a collider's unit mesh (shapes/shape.hpp)
 
     gl::Shader lit_;
     gl::Shader shadow_;

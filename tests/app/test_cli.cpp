@@ -25,6 +25,7 @@
 #include <vector>
 
 using Catch::Contains;
+using Catch::StartsWith;
 namespace fs = std::filesystem;
 
 namespace {
@@ -238,17 +239,22 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(p.at("slept_substeps") == 0);
     std::map<std::string, nlohmann::json> stage;
     for (const auto& s : p.at("stages")) stage[s.at("stage").get<std::string>()] = s;
-    CHECK(stage.size() == 17);
-    // drape-sphere: fast solver, sphere and ground, no wind, no cube, no cylinder, no limits.
+    CHECK(stage.size() == 14);
+    // drape-sphere: fast solver, a sphere and the ground, no wind, no limits.
     CHECK(stage.at("fast solver").at("state") == "runs");
     CHECK(stage.at("fast solver").at("substeps_run") == 30 * 109);
     CHECK(stage.at("fast solver").at("ms").get<double>() > 0.0);
     CHECK(stage.at("springs").at("state") == "fused");
-    CHECK(stage.at("sphere").at("state") == "runs");
-    CHECK(stage.at("sphere").at("blocks_offered") == 30 * 109 * 120);  // 40 rows of 3 blocks
-    CHECK(stage.at("sphere").at("blocks_tested").get<long long>() <= 30 * 109 * 120);
-    CHECK(stage.at("ground").at("blocks_tested") == 0);  // the cloth is far above the ground
-    for (const char* skipped : {"wind", "contact", "clips", "cube", "cylinder", "tethers", "strain limit", "speed limit"}) {
+    // The colliders stage: its note names the kinds, its block counts are per kind (every block offered to
+    // each collider of the kind each substep).
+    const nlohmann::json& colliders = stage.at("colliders");
+    CHECK(colliders.at("state") == "runs");
+    CHECK_THAT(colliders.at("note").get<std::string>(), StartsWith("sphere, plane: "));
+    CHECK(colliders.at("blocks_offered").at("sphere") == 30 * 109 * 120);  // 40 rows of 3 blocks
+    CHECK(colliders.at("blocks_tested").at("sphere").get<long long>() <= 30 * 109 * 120);
+    CHECK(colliders.at("blocks_tested").at("plane") == 0);  // the cloth is far above the ground
+    CHECK_FALSE(colliders.at("blocks_offered").contains("box"));  // no kind the scene does not hold
+    for (const char* skipped : {"wind", "contact", "clips", "tethers", "strain limit", "speed limit"}) {
         INFO(skipped);
         CHECK(stage.at(skipped).at("state") == "skipped");
         CHECK(stage.at(skipped).at("ms") == 0.0);
@@ -256,15 +262,13 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
         CHECK_FALSE(stage.at(skipped).at("note").get<std::string>().empty());
     }
     CHECK_THAT(stage.at("wind").at("note").get<std::string>(), Contains("forces.wind"));
-    CHECK_THAT(stage.at("cube").at("note").get<std::string>(), Contains("colliders.cube.enabled"));
-    CHECK_THAT(stage.at("cylinder").at("note").get<std::string>(), Contains("colliders.cylinder.enabled"));
     CHECK_THAT(stage.at("contact").at("note").get<std::string>(), Contains("colliders.contact is projection"));
     CHECK_THAT(stage.at("clips").at("note").get<std::string>(), Contains("no soft clip"));
     double sum = 0.0;
     for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
     CHECK(p.at("total_ms").get<double>() == Approx(sum));
 
-    // Penalty contact: the contact force stage runs every substep, the projection stages do not.
+    // Penalty contact: the contact force stage runs every substep, the projection stage does not.
     const RunResult penalty = run_clothsim({"--headless", "--scene", "drape-sphere", "--steps", "10", "--set",
                                             "colliders.contact=penalty", "--json"});
     CAPTURE_RUN(penalty);
@@ -274,13 +278,15 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     for (const auto& s : penalty_profile.at("stages")) with[s.at("stage").get<std::string>()] = s;
     CHECK(with.at("contact").at("state") == "runs");
     CHECK(with.at("contact").at("substeps_run") == 10 * 109);
-    for (const char* projection : {"sphere", "ground", "broad phase"}) {
+    CHECK_THAT(with.at("contact").at("note").get<std::string>(), Contains("sphere, plane"));
+    for (const char* projection : {"colliders", "broad phase"}) {
         INFO(projection);
         CHECK(with.at(projection).at("state") == "skipped");
         CHECK_THAT(with.at(projection).at("note").get<std::string>(), Contains("colliders.contact is penalty"));
     }
 
-    // The cylinder in the sphere's place: its stage runs and reports its broad phase, the sphere's is skipped.
+    // A cylinder in the sphere's place (the first form's names through --set): it is tested and reports its
+    // broad phase; the switched-off sphere is offered nothing.
     const RunResult cylinder = run_clothsim(
         {"--headless", "--scene", "drape-sphere", "--steps", "30", "--set", "colliders.sphere.enabled=false", "--set",
          "colliders.cylinder.enabled=true", "--set", "colliders.cylinder.center=[0, 0.425, 0]", "--set",
@@ -290,12 +296,14 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     const nlohmann::json cylinder_profile = nlohmann::json::parse(cylinder.out).at("profile");
     std::map<std::string, nlohmann::json> on;
     for (const auto& s : cylinder_profile.at("stages")) on[s.at("stage").get<std::string>()] = s;
-    CHECK(on.at("cylinder").at("state") == "runs");
-    CHECK(on.at("cylinder").at("substeps_run") == 30 * 109);
-    CHECK(on.at("cylinder").at("blocks_offered") == 30 * 109 * 120);
-    CHECK(on.at("cylinder").at("blocks_tested").get<long long>() > 0);  // the cloth lands on it in 0.17 s
-    CHECK(on.at("cylinder").at("blocks_tested").get<long long>() < 30 * 109 * 120);
-    CHECK(on.at("sphere").at("state") == "skipped");
+    const nlohmann::json& with_cylinder = on.at("colliders");
+    CHECK(with_cylinder.at("state") == "runs");
+    CHECK_THAT(with_cylinder.at("note").get<std::string>(), StartsWith("cylinder, plane: "));
+    CHECK(with_cylinder.at("substeps_run") == 30 * 109);
+    CHECK(with_cylinder.at("blocks_offered").at("cylinder") == 30 * 109 * 120);
+    CHECK(with_cylinder.at("blocks_tested").at("cylinder").get<long long>() > 0);  // the cloth lands on it in 0.17 s
+    CHECK(with_cylinder.at("blocks_tested").at("cylinder").get<long long>() < 30 * 109 * 120);
+    CHECK_FALSE(with_cylinder.at("blocks_offered").contains("sphere"));
 }
 
 TEST_CASE("cli: a headless run reports when the cloth slept, and bending 0 as a skipped spring kind") {
@@ -743,13 +751,28 @@ TEST_CASE("cli: --list-fields lists every scene field") {
     CAPTURE_RUN(r);
     CHECK(r.code == 0);
     const std::vector<std::string> lines = lines_of(r.out);
-    REQUIRE(lines.size() == clothsim::scene_fields().size());
+    std::size_t collider_rows = 0;
+    for (std::size_t kind = 0; kind < clothsim::kColliderKindCount; ++kind) {
+        collider_rows += clothsim::collider_fields_of_kind(kind).size();
+    }
+    REQUIRE(lines.size() == clothsim::scene_fields().size() + collider_rows);
     std::size_t i = 0;
     for (const clothsim::FieldInfo& f : clothsim::scene_fields()) {
         INFO("field " << f.name);
         CHECK(lines[i].rfind(std::string(f.name), 0) == 0);
         CHECK_THAT(lines[i], Contains(clothsim::describe_allowed(f)));
         ++i;
+    }
+    // Then each collider kind's fields, as a [[colliders.shapes]] entry of that kind holds them.
+    for (std::size_t kind = 0; kind < clothsim::kColliderKindCount; ++kind) {
+        for (const clothsim::ColliderField& f : clothsim::collider_fields_of_kind(kind)) {
+            const std::string name = "colliders.shapes[kind = " + std::string(clothsim::collider_kind_names()[kind]) +
+                                     "]." + std::string(f.name);
+            INFO("field " << name);
+            CHECK(lines[i].rfind(name, 0) == 0);
+            CHECK_THAT(lines[i], Contains(clothsim::describe_allowed(f)));
+            ++i;
+        }
     }
 }
 

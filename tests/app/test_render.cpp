@@ -183,7 +183,7 @@ struct ScreenDisc {
 ScreenDisc sphere_on_screen(const clothsim::Scene& scene) {
     // The camera frames the scene as built: without the sphere it frames the cloth alone.
     const clothsim::OrbitCamera camera = start_camera(clothsim::build_simulation(scene));
-    const clothsim::SphereCollider& sphere = scene.settings.colliders.sphere;
+    const clothsim::SphereCollider& sphere = clothsim::test::sphere(scene.settings.colliders);
     const glm::vec2 centre(to_screen(camera, sphere.center));
     const float up = glm::length(glm::vec2(to_screen(camera, sphere.center + sphere.radius * camera.up())) - centre);
     const float right =
@@ -194,7 +194,7 @@ ScreenDisc sphere_on_screen(const clothsim::Scene& scene) {
 // The screen box of the cube's eight corners in the app's start camera, clipped to the view.
 Rect cube_on_screen(const clothsim::Scene& scene) {
     const clothsim::OrbitCamera camera = start_camera(clothsim::build_simulation(scene));
-    const clothsim::CubeCollider& cube = scene.settings.colliders.cube;
+    const clothsim::BoxCollider& cube = clothsim::test::box(scene.settings.colliders);
     Rect box{kWidth, kHeight, 0, 0};
     for (int corner = 0; corner < 8; ++corner) {
         const glm::vec3 sign((corner & 1) ? 0.5f : -0.5f, (corner & 2) ? 0.5f : -0.5f, (corner & 4) ? 0.5f : -0.5f);
@@ -208,7 +208,7 @@ Rect cube_on_screen(const clothsim::Scene& scene) {
 // The screen box of the cylinder's two rims in the app's start camera, clipped to the view.
 Rect cylinder_on_screen(const clothsim::Scene& scene) {
     const clothsim::OrbitCamera camera = start_camera(clothsim::build_simulation(scene));
-    const clothsim::CylinderCollider& c = scene.settings.colliders.cylinder;
+    const clothsim::CylinderCollider& c = clothsim::test::cylinder(scene.settings.colliders);
     Rect box{kWidth, kHeight, 0, 0};
     for (int k = 0; k < 128; ++k) {
         const float phi = 6.2831853f * static_cast<float>(k) / 128.0f;
@@ -378,7 +378,7 @@ TEST_CASE("render the sphere of drape-sphere where it is, and no sphere when it 
     // After one frame the cloth is still flat above the sphere, which shows whole.
     const std::string disable = "colliders.sphere.enabled=false";
     clothsim::Scene scene = clothsim::load_scene("drape-sphere");
-    REQUIRE(scene.settings.colliders.sphere.enabled);
+    REQUIRE(clothsim::test::collider(scene.settings.colliders, "sphere").enabled);
     clothsim::Scene scene_without = scene;
     clothsim::apply_override(scene_without, disable);
     const ScreenDisc disc = sphere_on_screen(scene), disc_without = sphere_on_screen(scene_without);
@@ -408,7 +408,7 @@ TEST_CASE("render the sphere of drape-sphere where it is, and no sphere when it 
 TEST_CASE("render the crate of drape-cube where it is, and no crate when it is disabled") {
     const std::string disable = "colliders.cube.enabled=false";
     clothsim::Scene scene = clothsim::load_scene("drape-cube");
-    REQUIRE(scene.settings.colliders.cube.enabled);
+    REQUIRE(clothsim::test::collider(scene.settings.colliders, "cube").enabled);
     clothsim::Scene scene_without = scene;
     clothsim::apply_override(scene_without, disable);
     const Rect box = cube_on_screen(scene), box_without = cube_on_screen(scene_without);

@@ -606,3 +606,32 @@ TEST_CASE("user session: each pin of hanging and curtain dragged 300 px in half 
         CHECK_THAT(r.err, !Contains("guard") && !Contains("strain") && !Contains("failed") && !Contains("paused"));
     }
 }
+
+TEST_CASE("user session: the Colliders section adds a box, removes the ground and grows the sphere, live, and Save writes the list") {
+    const TempDir dir("session_collider_list");
+    // drape-sphere, paused: Springs and Integration folded so the Colliders section opens in view. Its list
+    // holds "0: sphere" (radius at y = 375) and "1: plane" (its remove button at x = 117, y = 396), then the
+    // add-collider combo, whose second item is "box".
+    const RunResult r = run_user_session(
+        dir, {"--scene", "drape-sphere", "--paused"},
+        std::string("click 60 197\nclick 60 243\nclick 60 266\nshot colliders.png\n") +
+            "click 120 484\nclick 25 525\nclick 117 396\ndrag 120 375 160 375\nshot edited.png\n" +
+            "echo \"title edited: $(xdotool getwindowname $wid)\"\nclick " + kSave +
+            "\nwait_for drape-sphere-edited.toml\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.out, Contains("title edited: clothsim - drape-sphere*\n"));
+    const fs::path saved = dir / "drape-sphere-edited.toml";
+    REQUIRE(fs::exists(saved));
+    const clothsim::Scene reopened = clothsim::load_scene(saved.string());
+    const std::vector<clothsim::Collider>& shapes = reopened.settings.colliders.shapes;
+    REQUIRE(shapes.size() == 2);  // the sphere, then the added box; the ground is gone
+    const auto* sphere = std::get_if<clothsim::SphereCollider>(&shapes[0].shape);
+    const auto* box = std::get_if<clothsim::BoxCollider>(&shapes[1].shape);
+    REQUIRE(sphere);
+    REQUIRE(box);
+    CHECK(sphere->radius > 0.35f);  // dragged larger than the scene's
+    CHECK(*box == clothsim::BoxCollider{});  // a new box has the defaults
+    CHECK(shapes[1].enabled);
+}

@@ -53,7 +53,6 @@ Box swept(Box box) {
 }
 
 // Whether the collider moves a lone free particle at p (or changes its motion).
-template <class Collider>
 bool collider_moves(const Collider& collider, float thickness, glm::vec3 p) {
     State st = test::free_particles({p}, 1.0f);
     st.motion.set(0, kMotion);
@@ -94,7 +93,6 @@ struct Tally {
 
 // Checks one particle: if its one-point box is rejected, the collider must not move it; then the same for
 // a small box around it (every corner and the centre).
-template <class Collider>
 void check_conservative(const Collider& collider, float thickness, glm::vec3 p, std::mt19937& rng, Tally& tally) {
     const bool moves = collider_moves(collider, thickness, p);
     tally.moved += moves;
@@ -162,10 +160,10 @@ TEST_CASE("broad_phase particle_bounds is the box of the finite coordinates of i
     CHECK(Box{}.empty());
     const Box none = particle_bounds(p, 3, 4);
     REQUIRE(none.empty());
-    CHECK_FALSE(may_touch(SphereCollider{true, glm::vec3(0.0f), 1e6f, 0.0f}, 1.0f, none));
-    CHECK_FALSE(may_touch(CubeCollider{true, glm::vec3(0.0f), glm::vec3(1e6f), 0.0f}, 1.0f, none));
-    CHECK_FALSE(may_touch(CylinderCollider{true, glm::vec3(0.0f), 1e6f, 1e6f, 0.0f}, 1.0f, none));
-    CHECK_FALSE(may_touch(GroundCollider{true, 1e6f, 0.0f}, 1.0f, none));
+    CHECK_FALSE(may_touch(SphereCollider{glm::vec3(0.0f), 1e6f}, 1.0f, none));
+    CHECK_FALSE(may_touch(BoxCollider{glm::vec3(0.0f), glm::vec3(1e6f)}, 1.0f, none));
+    CHECK_FALSE(may_touch(CylinderCollider{glm::vec3(0.0f), 1e6f, 1e6f}, 1.0f, none));
+    CHECK_FALSE(may_touch(PlaneCollider{1e6f}, 1.0f, none));
 }
 
 TEST_CASE("broad_phase union_of is the box around its boxes, a NaN bound left out, as folding glm::min and glm::max",
@@ -267,10 +265,10 @@ TEST_CASE("broad_phase block_starts cuts grid rows into runs of kBlockParticles 
 TEST_CASE("broad_phase block_bounds_for asks for lowest points when no collider but the ground can reach the cloth",
           "[broad_phase]") {
     ColliderSettings c;
-    c.ground.enabled = true;
+    test::collider(c, "ground").enabled = true;
     CollisionBlocks blocks;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Lowest);  // the ground alone
-    c.sphere = SphereCollider{true, {0.0f, 5.0f, 0.0f}, 0.5f, 0.3f};
+    test::collider(c, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.5f}, 0.3f, true};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);  // no valid carried box
     blocks.carried_valid = true;
     blocks.carried_lo = glm::dvec3(-1.0, 0.0, -1.0), blocks.carried_hi = glm::dvec3(1.0, 2.0, 1.0);
@@ -278,15 +276,15 @@ TEST_CASE("broad_phase block_bounds_for asks for lowest points when no collider 
     blocks.carried_hi.y = 4.6;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);  // within its radius
     blocks.carried_hi.y = 2.0;
-    c.cube = CubeCollider{true, {0.0f, 1.0f, 1.2f}, {0.5f, 0.5f, 0.5f}, 0.3f};
+    test::collider(c, "cube") = Collider{BoxCollider{{0.0f, 1.0f, 1.2f}, {0.5f, 0.5f, 0.5f}}, 0.3f, true};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);
-    c.cube.enabled = false;
-    c.cylinder = CylinderCollider{true, {3.0f, 1.0f, 0.0f}, 0.5f, 1.0f, 0.3f};
+    test::collider(c, "cube").enabled = false;
+    test::collider(c, "cylinder") = Collider{CylinderCollider{{3.0f, 1.0f, 0.0f}, 0.5f, 1.0f}, 0.3f, true};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Lowest);
-    c.cylinder.center.x = 1.4f;
+    test::cylinder(c).center.x = 1.4f;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);
     // The ground reads nothing of a box but its lowest y: an open box tests as the whole one.
-    const GroundCollider ground{true, 0.2f, 0.5f};
+    const PlaneCollider ground{0.2f};
     for (float y : {-1.0f, 0.19f, 0.2f, 0.2049f, 0.21f, 3.0f}) {
         const Box whole{{0.3f, y, -0.4f}, {0.5f, y + 0.7f, 0.1f}};
         const Box open{{-INFINITY, y, -INFINITY}, glm::vec3(INFINITY)};
@@ -305,10 +303,11 @@ TEST_CASE("broad_phase a cloth hanging onto the ground moves the same with or wi
             Scene s = load_scene("hanging");
             apply_override(s, "cloth.rows=24");
             apply_override(s, "cloth.cols=24");
-            s.settings.colliders.ground.height = 1.0f;
+            test::plane(s.settings.colliders).height = 1.0f;
             s.settings.solver.threads = threads;
             Scene with_sphere = s;
-            with_sphere.settings.colliders.sphere = SphereCollider{true, {0.0f, 30.0f, 0.0f}, 1.0f, 0.3f};
+            test::collider(with_sphere.settings.colliders, "sphere") =
+                Collider{SphereCollider{{0.0f, 30.0f, 0.0f}, 1.0f}, 0.3f, true};
             REQUIRE(block_bounds_for(s.settings.colliders, CollisionBlocks{}) == BlockBounds::Lowest);
             MassSpring lowest = build_simulation(s), whole = build_simulation(with_sphere);
             REQUIRE(lowest.plan().path == StepPath::Fast);
@@ -321,7 +320,7 @@ TEST_CASE("broad_phase a cloth hanging onto the ground moves the same with or wi
             for (double y : lowest.state().position.y) low = std::min(low, y);
             CHECK(low < 1.0 + 2.0 * s.settings.colliders.thickness);  // on the ground
             const StepProfile& profile = lowest.profile();
-            const int ground = collider_index(Stage::Ground);
+            const std::size_t ground = Collider::of(PlaneCollider{}).kind();
             CHECK(profile.blocks_tested[ground] > 0);
             CHECK(profile.blocks_tested[ground] < profile.blocks_offered[ground]);  // the rest are culled
         }
@@ -338,7 +337,7 @@ Scene hanging_over_sphere(int threads, bool broad_phase, float tether_strain = 0
     apply_override(s, "cloth.rows=40");
     apply_override(s, "cloth.cols=40");
     s.settings.springs.tether_strain = tether_strain;
-    s.settings.colliders.sphere = SphereCollider{true, {0.0f, 0.37f, -0.3f}, 0.2f, 0.3f};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.37f, -0.3f}, 0.2f}, 0.3f, true};
     s.settings.solver.threads = threads;
     s.settings.solver.broad_phase = broad_phase;
     return s;
@@ -414,7 +413,7 @@ TEST_CASE("broad_phase a cloth moved into the sphere between steps is pushed out
             REQUIRE(sim.collision_blocks().bounds == BlockBounds::Lowest);
             REQUIRE(sim.collision_blocks().carried_lo.y > 1.0);
         }
-        const SphereCollider& sphere = sim.settings().colliders.sphere;
+        const SphereCollider& sphere = test::sphere(sim.settings().colliders);
         const glm::dvec3 centre(sphere.center);
         const glm::dvec3 shift = centre - sim.state().position.get(40 * 20 + 20);  // a middle particle to the centre
         const std::vector<glm::vec3> velocity = sim.velocities();
@@ -443,14 +442,15 @@ TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has mo
         MassSpring sim = build_simulation(hanging_over_sphere(1, broad_phase, 0.0f));
         sim.run_steps(3);
         if (broad_phase) REQUIRE(sim.collision_blocks().bounds == BlockBounds::Lowest);
-        test::edit_settings(sim, [](SimulationSettings& s) { s.colliders.sphere.enabled = false; });
+        test::edit_settings(sim, [](SimulationSettings& s) { test::collider(s.colliders, "sphere").enabled = false; });
         sim.run_steps(25);
         const glm::vec3 middle(sim.state().position.get(40 * 20 + 20));
         test::edit_settings(sim, [&](SimulationSettings& s) {
-            s.colliders.sphere = SphereCollider{true, middle + glm::vec3(0.0f, 0.0f, 0.02f), 0.1f, 0.3f};
+            test::collider(s.colliders, "sphere") =
+                Collider{SphereCollider{middle + glm::vec3(0.0f, 0.0f, 0.02f), 0.1f}, 0.3f, true};
         });
         sim.step();
-        const SphereCollider& sphere = sim.settings().colliders.sphere;
+        const SphereCollider& sphere = test::sphere(sim.settings().colliders);
         int inside_sphere = 0;
         for (std::size_t i = 0; i < sim.state().size(); ++i) {
             inside_sphere += glm::length(sim.state().position.get(i) - glm::dvec3(sphere.center)) <
@@ -465,7 +465,7 @@ TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has mo
 TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of the motion, from a pass when they "
           "are not finite", "[broad_phase]") {
     ColliderSettings colliders;
-    colliders.sphere = {true, {0.0f, 5.0f, 0.0f}, 0.3f, 0.4f};  // out of reach
+    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.3f}, 0.4f, true};  // out of reach
     std::mt19937 rng(8);
     State st = free_state(100);
     for (std::size_t i = 0; i < 100; ++i) {
@@ -499,10 +499,10 @@ TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of
 
 TEST_CASE("broad_phase may_touch rejects a far box and accepts a box holding the collider's centre",
           "[broad_phase]") {
-    const SphereCollider sphere{true, {0.0f, 0.5f, 0.0f}, 0.3f, 0.3f};
-    const CubeCollider cube{true, {1.0f, 0.4f, -2.0f}, {0.5f, 0.2f, 0.8f}, 0.3f};
-    const CylinderCollider cylinder{true, {-1.0f, 0.3f, 1.0f}, 0.09f, 0.6f, 0.3f};
-    const GroundCollider ground{true, -0.25f, 0.5f};
+    const SphereCollider sphere{{0.0f, 0.5f, 0.0f}, 0.3f};
+    const BoxCollider cube{{1.0f, 0.4f, -2.0f}, {0.5f, 0.2f, 0.8f}};
+    const CylinderCollider cylinder{{-1.0f, 0.3f, 1.0f}, 0.09f, 0.6f};
+    const PlaneCollider ground{-0.25f};
     const float t = 0.005f;
     const Box far{{10.0f, 10.0f, 10.0f}, {11.0f, 12.0f, 13.0f}};
     CHECK_FALSE(may_touch(sphere, t, far));
@@ -538,10 +538,10 @@ TEST_CASE("broad_phase may_touch never rejects a particle the sphere would move"
     std::uniform_real_distribution<float> radius(0.01f, 2.0f), thickness(0.0f, 0.02f);
     Tally tally;
     for (int trial = 0; trial < kTrials; ++trial) {
-        const SphereCollider sphere{true, random_vec(rng, pick_scale(rng)), radius(rng), 0.4f};
+        const SphereCollider sphere{random_vec(rng, pick_scale(rng)), radius(rng)};
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         const glm::vec3 p = sphere.center + random_direction(rng) * (sphere.radius + t + offset(rng));
-        check_conservative(sphere, t, p, rng, tally);
+        check_conservative(Collider{sphere, 0.4f, true}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
@@ -552,7 +552,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cube would move", 
     std::uniform_int_distribution<int> axis(0, 2);
     Tally tally;
     for (int trial = 0; trial < kTrials; ++trial) {
-        const CubeCollider cube{true, random_vec(rng, pick_scale(rng)), {edge(rng), edge(rng), edge(rng)}, 0.4f};
+        const BoxCollider cube{random_vec(rng, pick_scale(rng)), {edge(rng), edge(rng), edge(rng)}};
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         const glm::vec3 reach = 0.5f * cube.size + t;
         // A point near a face, or (one time in three) near an edge or a corner too.
@@ -562,7 +562,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cube would move", 
             const int a = axis(rng);
             local[a] = (unit(rng) < 0.0f ? -1.0f : 1.0f) * (reach[a] + offset(rng));
         }
-        check_conservative(cube, t, cube.center + local, rng, tally);
+        check_conservative(Collider{cube, 0.4f, true}, t, cube.center + local, rng, tally);
     }
     check_coverage(tally);
 }
@@ -573,7 +573,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cylinder would mov
     std::uniform_real_distribution<float> angle(0.0f, 6.2831853f);
     Tally tally;
     for (int trial = 0; trial < kTrials; ++trial) {
-        const CylinderCollider cylinder{true, random_vec(rng, pick_scale(rng)), size(rng), size(rng), 0.4f};
+        const CylinderCollider cylinder{random_vec(rng, pick_scale(rng)), size(rng), size(rng)};
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         const float reach_r = cylinder.radius + t, reach_y = 0.5f * cylinder.height + t;
         // A point near the side, near a face, or (one time in three) near a rim: at the reach plus an offset.
@@ -590,7 +590,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cylinder would mov
             y = (y < 0.0f ? -1.0f : 1.0f) * (0.5f * cylinder.height + d * std::sin(b));
         }
         const glm::vec3 p = cylinder.center + glm::vec3(r * std::cos(a), y, r * std::sin(a));
-        check_conservative(cylinder, t, p, rng, tally);
+        check_conservative(Collider{cylinder, 0.4f, true}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
@@ -601,21 +601,23 @@ TEST_CASE("broad_phase may_touch never rejects a particle the ground would move"
     Tally tally;
     for (int trial = 0; trial < kTrials; ++trial) {
         const float scale = pick_scale(rng);
-        const GroundCollider ground{true, std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng) * scale, 0.5f};
+        const PlaneCollider ground{std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng) * scale};
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         glm::vec3 p = random_vec(rng, scale + 1.0f);
         p.y = ground.height + t + offset(rng);
-        check_conservative(ground, t, p, rng, tally);
+        check_conservative(Collider{ground, 0.5f, true}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
 
 TEST_CASE("broad_phase collide_stage with culling moves every particle exactly as testing them all", "[broad_phase]") {
     ColliderSettings colliders;
-    colliders.sphere = {true, {0.0f, 0.3f, 0.0f}, 0.3f, 0.4f};  // resting on the ground
-    colliders.cube = {true, {0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}, 0.3f};
-    colliders.cylinder = {true, {-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f, 0.3f};  // on the ground too
-    colliders.ground = {true, 0.0f, 0.5f};
+    colliders.shapes = {
+        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true},  // resting on the ground
+        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
+        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},  // on the ground too
+        Collider{PlaneCollider{0.0f}, 0.5f, true},
+    };
     colliders.thickness = 0.005f;
 
     // A particle inside the sphere near its bottom is pushed below the ground: its block's box must be
@@ -627,8 +629,8 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         StepProfile profile;
         collide_stage(st, colliders, true, blocks, &profile);
         INFO("particle at (" << st.position.x[0] << ", " << st.position.y[0] << ", " << st.position.z[0] << ")");
-        CHECK(st.position.y[0] >= colliders.ground.height + colliders.thickness);
-        const int ground = collider_index(Stage::Ground);
+        CHECK(st.position.y[0] >= test::plane(colliders).height + colliders.thickness);
+        const std::size_t ground = Collider::of(PlaneCollider{}).kind();
         CHECK(profile.blocks_tested[ground] == 1);  // the far particle's block is culled
         CHECK(profile.blocks_offered[ground] == 2);
     }
@@ -664,7 +666,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         CHECK(sorted.position == all.position);
         CHECK(sorted.motion == all.motion);
         CHECK(!(sorted.position == culled.position));  // something was pushed
-        for (std::size_t c = 0; c < kColliderCount; ++c) {
+        for (std::size_t c = 0; c < kColliderKindCount; ++c) {
             INFO("collider " << c << ": " << profile.blocks_tested[c] << " of " << profile.blocks_offered[c]);
             CHECK(profile.blocks_tested[c] > 0);
             if (size <= kBlockParticles) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);
@@ -674,10 +676,12 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
 
 TEST_CASE("broad_phase collide_stage shared by threads moves every particle exactly as testing them all", "[broad_phase]") {
     ColliderSettings colliders;
-    colliders.sphere = {true, {0.0f, 0.3f, 0.0f}, 0.3f, 0.4f};
-    colliders.cube = {true, {0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}, 0.3f};
-    colliders.cylinder = {true, {-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f, 0.3f};
-    colliders.ground = {true, 0.0f, 0.5f};
+    colliders.shapes = {
+        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true},
+        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
+        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},
+        Collider{PlaneCollider{0.0f}, 0.5f, true},
+    };
     colliders.thickness = 0.005f;
     // Enough particles for the stage to share its blocks among threads, in the cloth's order (blocks along x).
     const std::size_t n = 4 * kParallelCollisionParticles + 333;  // the ground's threshold too
@@ -703,7 +707,7 @@ TEST_CASE("broad_phase collide_stage shared by threads moves every particle exac
         collide_stage(shared, colliders, true, blocks, &profile, threads);
         CHECK(shared.position == all.position);
         CHECK(shared.motion == all.motion);
-        for (std::size_t c = 0; c < kColliderCount; ++c) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);
+        for (std::size_t c = 0; c < kColliderKindCount; ++c) CHECK(profile.blocks_tested[c] < profile.blocks_offered[c]);
     }
     CHECK(!(all.position == start.position));  // something was pushed
 }

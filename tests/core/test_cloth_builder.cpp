@@ -246,7 +246,7 @@ TEST_CASE("apply_fabric: a hanging cloth stiffened live settles where a cloth bu
     soft.material.explicit_fields |= kMaterialStretch | kMaterialShear;
     soft.settings.springs.damping = 8.0f;
     soft.settings.springs.tether_strain = 0.0f;
-    soft.settings.colliders.ground.enabled = false;
+    test::collider(soft.settings.colliders, "ground").enabled = false;
     derive_springs(soft);
     const Scene stiff = fabric_scaled(soft, 10.0f, 1.0f);
     // One substep for both, inside the stiff cloth's limit.

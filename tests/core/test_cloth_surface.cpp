@@ -34,7 +34,7 @@ MassSpring flat_cloth() {
     s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
     s.pins.preset = PinPreset::None;
     s.settings.forces.gravity = glm::vec3(0.0f);
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     return build_simulation(s);
 }
 

@@ -9,10 +9,17 @@
 #include <glm/geometric.hpp>
 
 #include <cmath>
+#include <variant>
 
 using namespace clothsim;
 
 namespace {
+
+// A collider of `shape`, switched on and frictionless.
+template <class Shape>
+Collider frictionless(const Shape& shape) {
+    return Collider{shape, 0.0f, true};
+}
 
 // Smallest signed distance of a free particle to each enabled collider (m).
 struct Clearance {
@@ -25,9 +32,13 @@ Clearance clearance(const MassSpring& sim) {
     for (std::size_t i = 0; i < sim.particle_count(); ++i) {
         if (sim.particle(i).pinned) continue;
         const glm::vec3 p = sim.position(i);
-        if (col.sphere.enabled) c.sphere = std::min(c.sphere, signed_distance(col.sphere, p));
-        if (col.cube.enabled) c.cube = std::min(c.cube, signed_distance(col.cube, p));
-        if (col.ground.enabled) c.ground = std::min(c.ground, signed_distance(col.ground, p));
+        for (const Collider& collider : col.shapes) {
+            if (!collider.enabled) continue;
+            const float d = signed_distance(collider, p);
+            if (std::holds_alternative<SphereCollider>(collider.shape)) c.sphere = std::min(c.sphere, d);
+            if (std::holds_alternative<BoxCollider>(collider.shape)) c.cube = std::min(c.cube, d);
+            if (std::holds_alternative<PlaneCollider>(collider.shape)) c.ground = std::min(c.ground, d);
+        }
     }
     return c;
 }
@@ -36,7 +47,7 @@ Clearance clearance(const MassSpring& sim) {
 MassSpring slider(float friction, float speed) {
     Scene s = test::chain(1, 1.0f, 0.1f, 0.0f);
     s.settings.forces.gravity = {0.0f, -9.81f, 0.0f};
-    s.settings.colliders.ground = {true, 0.0f, friction};
+    test::collider(s.settings.colliders, "ground") = Collider{PlaneCollider{0.0f}, friction, true};
     s.settings.colliders.thickness = 0.005f;
     s.cloth.origin = {0.0f, 0.005f, 0.0f};
     s.cloth.velocity = {speed, 0.0f, 0.0f};
@@ -47,8 +58,8 @@ MassSpring slider(float friction, float speed) {
 
 // The Cusick drape tester's support (ISO 9073-9, BS 5058: an 18 cm disc), here a solid cylinder 0.3 m tall
 // standing on y = 0.1; its top face is at y = 0.4.
-CylinderCollider support(float friction) {
-    return {true, {0.1f, 0.25f, -0.2f}, 0.09f, 0.3f, friction};
+Collider support(float friction) {
+    return Collider{CylinderCollider{{0.1f, 0.25f, -0.2f}, 0.09f, 0.3f}, friction, true};
 }
 
 // One free particle at `start` moving at `velocity`, with gravity, no ground, `substeps` per 1/60 s step.
@@ -68,8 +79,8 @@ Scene lone_particle(glm::vec3 start, glm::vec3 velocity, int substeps) {
 // substeps a step: implicit Euler's 180 steps stay short).
 Scene drape_on_cylinder() {
     Scene s = per_spring_scene("drape-sphere");
-    s.settings.colliders.sphere.enabled = false;
-    s.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
+    test::collider(s.settings.colliders, "sphere").enabled = false;
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
     return s;
 }
 
@@ -106,7 +117,7 @@ TEST_CASE("colliders push particles out along the shortest way", "[colliders]") 
     st.position.set(1, {0.45f, 0.5f, 0.1f});  // nearest the +x face
     st.position.set(2, {0.0f, 0.2f, -0.48f}); // nearest the -z face
     st.position.set(3, {0.0f, 0.5f, 0.0f});   // pinned: never moved, even inside
-    const CubeCollider cube{true, {0.0f, 0.5f, 0.0f}, {1.0f, 1.0f, 1.0f}, 0.0f};
+    const Collider cube = frictionless(BoxCollider{{0.0f, 0.5f, 0.0f}, {1.0f, 1.0f, 1.0f}});
     collide(st, cube, 0.01f);
     CHECK(st.position.get(0).y == Approx(1.01f));
     CHECK(st.position.get(0).x == 0.0f);
@@ -128,7 +139,7 @@ TEST_CASE("colliders push particles out along the shortest way", "[colliders]") 
     CHECK(st.motion.get(0).y == Approx(0.03f));
 
     st.position.set(0, {0.3f, 0.4f, 0.0f});  // inside the sphere of radius 1 at the origin
-    collide(st, SphereCollider{true, {0.0f, 0.0f, 0.0f}, 1.0f, 0.0f}, 0.0f);
+    collide(st, frictionless(SphereCollider{{0.0f, 0.0f, 0.0f}, 1.0f}), 0.0f);
     CHECK(glm::length(st.position.get(0)) == Approx(1.0f));
     CHECK(st.position.get(0).x == Approx(0.6f));
     CHECK(st.position.get(0).y == Approx(0.8f));
@@ -159,14 +170,14 @@ TEST_CASE("colliders friction > 0 slows sliding at mu g and stops it at v^2 / (2
 }
 
 TEST_CASE("colliders signed distances", "[colliders]") {
-    const SphereCollider sphere{true, {1.0f, 0.0f, 0.0f}, 0.5f, 0.0f};
+    const SphereCollider sphere{{1.0f, 0.0f, 0.0f}, 0.5f};
     CHECK(signed_distance(sphere, {1.0f, 0.0f, 0.0f}) == Approx(-0.5f));
     CHECK(signed_distance(sphere, {1.0f, 2.0f, 0.0f}) == Approx(1.5f));
-    const CubeCollider cube{true, {0.0f, 0.0f, 0.0f}, {2.0f, 2.0f, 2.0f}, 0.0f};
+    const BoxCollider cube{{0.0f, 0.0f, 0.0f}, {2.0f, 2.0f, 2.0f}};
     CHECK(signed_distance(cube, {0.0f, 0.0f, 0.0f}) == Approx(-1.0f));
     CHECK(signed_distance(cube, {0.0f, 0.5f, 0.0f}) == Approx(-0.5f));
     CHECK(signed_distance(cube, {2.0f, 2.0f, 1.0f}) == Approx(std::sqrt(2.0f)));
-    CHECK(signed_distance(GroundCollider{true, -1.0f, 0.0f}, {5.0f, 1.0f, 5.0f}) == Approx(2.0f));
+    CHECK(signed_distance(PlaneCollider{-1.0f}, {5.0f, 1.0f, 5.0f}) == Approx(2.0f));
 }
 
 TEST_CASE("colliders a particle too fast for one substep does not pass through the sphere or the cube",
@@ -174,11 +185,9 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
     // 2 m in one substep straight through the middle of each (radius 0.3, a 0.4 m box): without a swept test
     // it ends outside on the far side, untouched.
     SphereCollider sphere;
-    sphere.enabled = true;
     sphere.center = {0.0f, 0.0f, 0.0f};
     sphere.radius = 0.3f;
-    CubeCollider cube;
-    cube.enabled = true;
+    BoxCollider cube;
     cube.center = {0.0f, 0.0f, 0.0f};
     cube.size = {0.4f, 0.4f, 0.4f};
     const float thickness = 0.01f;
@@ -189,8 +198,8 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
             INFO("ends at x = " << end);
             State st = test::free_particles({{end, 0.0f, 0.0f}}, 0.01f);
             st.motion.set(0, {end + 1.0f, 0.0f, 0.0f});  // came from x = -1
-            if (shape == 0) collide(st, sphere, thickness);
-            else collide(st, cube, thickness);
+            if (shape == 0) collide(st, Collider::of(sphere), thickness);
+            else collide(st, Collider::of(cube), thickness);
             const float face = shape == 0 ? sphere.radius : 0.5f * cube.size.x;
             CHECK(st.position.get(0).x == Approx(-(face + thickness)).margin(1e-5));  // stopped at the near side
             CHECK(st.motion.get(0).x == Approx(0.0f).margin(1e-6));                   // its inward motion gone
@@ -199,7 +208,7 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
     // A glancing path that stays in the thickness shell (a particle sliding over the top) is not a pass.
     State slide = test::free_particles({{0.01f, sphere.radius + thickness, 0.0f}}, 0.01f);
     slide.motion.set(0, {0.02f, 0.0f, 0.0f});
-    collide(slide, sphere, thickness);
+    collide(slide, Collider::of(sphere), thickness);
     CHECK(slide.position.get(0).x == Approx(0.01f));
 }
 
@@ -214,7 +223,7 @@ TEST_CASE("colliders implicit Euler, XPBD and projective at dt 0.1 with 1 subste
         MassSpring sim = build_simulation(scene);
         sim.run_steps(30);  // 3 s
         REQUIRE(sim.all_finite());
-        const SphereCollider& sphere = scene.settings.colliders.sphere;
+        const SphereCollider& sphere = test::sphere(scene.settings.colliders);
         // The cloth lies on the sphere, not on the ground below it, and no particle is inside it.
         float highest = -1e9f;
         for (std::size_t i = 0; i < sim.particle_count(); ++i) highest = std::max(highest, sim.position(i).y);
@@ -226,14 +235,15 @@ TEST_CASE("colliders implicit Euler, XPBD and projective at dt 0.1 with 1 subste
 }
 
 TEST_CASE("colliders a particle dropped on the cylinder's top face rests at top + thickness", "[colliders]") {
-    const CylinderCollider cylinder = support(0.3f);
+    const Collider support_disc = support(0.3f);
+    const CylinderCollider& cylinder = std::get<CylinderCollider>(support_disc.shape);
     const double top = double(cylinder.center.y) + 0.5 * double(cylinder.height);
     const double thickness = 0.005;
     for (const char* integrator : {"verlet", "symplectic-euler", "rk4", "implicit-euler", "xpbd", "projective"}) {
         INFO(integrator);
         // Off the axis, dropped from 0.2 m above the top: it lands at 2 m/s after 0.2 s.
         Scene s = lone_particle({0.13f, 0.6f, -0.17f}, glm::vec3(0.0f), 20);
-        s.settings.colliders.cylinder = cylinder;
+        test::collider(s.settings.colliders, "cylinder") = support_disc;
         apply_override(s, std::string("integration.integrator=") + integrator);
         MassSpring sim = build_simulation(s);
         double lowest = INFINITY;
@@ -256,7 +266,7 @@ TEST_CASE("colliders a particle dropped on the cylinder's top face rests at top 
 TEST_CASE("colliders the cylinder pushes particles out along the shortest way: faces, side, rims",
           "[colliders]") {
     // Radius 0.5, height 1 around the origin: the top face at y = 0.5, the side at r = 0.5.
-    const CylinderCollider cylinder{true, {0.0f, 0.0f, 0.0f}, 0.5f, 1.0f, 0.0f};
+    const CylinderCollider cylinder{{0.0f, 0.0f, 0.0f}, 0.5f, 1.0f};
     const float t = 0.01f;
     const glm::vec3 dir(std::cos(1.0f), 0.0f, -std::sin(1.0f));  // an arbitrary direction around the axis
     State st = test::free_particles({{0.1f, 0.45f, 0.2f},      // inside, nearest the top face
@@ -267,7 +277,7 @@ TEST_CASE("colliders the cylinder pushes particles out along the shortest way: f
                                      {0.0f, 0.0f, 0.0f}},      // on the axis, at the centre: out of a face
                                     0.01f);
     st.pinned[4] = 1;
-    collide(st, cylinder, t);
+    collide(st, frictionless(cylinder), t);
     CHECK(st.position.get(0).y == Approx(0.51));
     CHECK(st.position.get(0).x == Approx(0.1f));
     CHECK(st.position.get(0).z == Approx(0.2f));
@@ -290,7 +300,7 @@ TEST_CASE("colliders the cylinder pushes particles out along the shortest way: f
     State rim = test::free_particles({{0.45f, 0.48f, 0.0f}, {0.48f, 0.45f, 0.0f}, {0.503f, 0.504f, 0.0f},
                                       0.503f * dir + glm::vec3(0.0f, -0.504f, 0.0f)},
                                      0.01f);
-    collide(rim, cylinder, t);
+    collide(rim, frictionless(cylinder), t);
     CHECK(rim.position.get(0).y == Approx(0.51));  // 0.02 below the top, 0.05 inside the side: up
     CHECK(rim.position.get(0).x == Approx(0.45f));
     CHECK(rim.position.get(1).x == Approx(0.51));  // 0.05 below the top, 0.02 inside the side: out
@@ -318,18 +328,18 @@ TEST_CASE("colliders the cylinder pushes particles out along the shortest way: f
 }
 
 TEST_CASE("colliders the cylinder removes inward motion and keeps the rest when frictionless", "[colliders]") {
-    const CylinderCollider cylinder{true, {0.0f, 0.0f, 0.0f}, 0.5f, 1.0f, 0.0f};
+    const CylinderCollider cylinder{{0.0f, 0.0f, 0.0f}, 0.5f, 1.0f};
     State st = test::free_particles({{0.1f, 0.505f, 0.0f}, {0.0f, 0.0f, 0.505f}}, 0.01f);
     st.motion.set(0, {0.02f, -0.01f, 0.0f});  // sliding over the top face and into it
     st.motion.set(1, {0.01f, 0.0f, -0.004f});  // sliding around the side and into it
-    collide(st, cylinder, 0.01f);
+    collide(st, frictionless(cylinder), 0.01f);
     CHECK(st.motion.get(0).x == Approx(0.02f));
     CHECK(st.motion.get(0).y == 0.0);
     CHECK(st.motion.get(1).x == Approx(0.01f));
     CHECK(st.motion.get(1).z == 0.0);
     st.position.set(0, {0.1f, 0.505f, 0.0f});
     st.motion.set(0, {0.0f, 0.03f, 0.0f});  // already leaving: keeps its outward motion
-    collide(st, cylinder, 0.01f);
+    collide(st, frictionless(cylinder), 0.01f);
     CHECK(st.motion.get(0).y == Approx(0.03f));
 }
 
@@ -337,8 +347,8 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
     // Straight paths of 2 m in one substep through the middle of a cylinder of radius 0.3 around the origin:
     // across a tall one (height 1) through the side, down a flat one (height 0.4) through the top face. Each
     // is shaped so that 0.05 m past the centre the nearest way out is through the far side of the path.
-    const CylinderCollider tall{true, {0.0f, 0.0f, 0.0f}, 0.3f, 1.0f, 0.0f};
-    const CylinderCollider flat{true, {0.0f, 0.0f, 0.0f}, 0.3f, 0.4f, 0.0f};
+    const CylinderCollider tall{{0.0f, 0.0f, 0.0f}, 0.3f, 1.0f};
+    const CylinderCollider flat{{0.0f, 0.0f, 0.0f}, 0.3f, 0.4f};
     const float thickness = 0.01f;
     struct Path {
         const char* what;
@@ -354,7 +364,7 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
             INFO(path.what << ", ends " << end << " m past the centre");
             State st = test::free_particles({end * path.axis}, 0.01f);
             st.motion.set(0, (end + 1.0f) * path.axis);  // came from 1 m before the centre
-            collide(st, path.cylinder, thickness);
+            collide(st, frictionless(path.cylinder), thickness);
             const glm::dvec3 p = st.position.get(0);
             CHECK(glm::dot(p, glm::dvec3(path.axis)) == Approx(-(path.face + thickness)).margin(1e-5));  // near side
             CHECK(glm::length(p - glm::dot(p, glm::dvec3(path.axis)) * glm::dvec3(path.axis)) < 1e-6);  // on its path
@@ -368,7 +378,7 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
         State st = test::free_particles({{-0.5f, -0.5f, 0.0f}}, 0.01f);
         const glm::dvec3 start(0.35, 0.4, 0.0);
         st.motion.set(0, st.position.get(0) - start);
-        collide(st, cylinder, thickness);
+        collide(st, frictionless(cylinder), thickness);
         const glm::dvec3 p = st.position.get(0);
         CHECK(signed_distance(cylinder, p) > 0.0f);
         CHECK(p.y == Approx(0.2 + thickness).margin(1e-5));  // where the path met the top face's shell
@@ -383,7 +393,7 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
         REQUIRE(signed_distance(cylinder, glm::vec3(start)) > thickness);
         State st = test::free_particles({{-1.0f, 0.0f, 0.0f}}, 0.01f);
         st.motion.set(0, st.position.get(0) - start);
-        collide(st, cylinder, thickness);
+        collide(st, frictionless(cylinder), thickness);
         CHECK(glm::length(st.position.get(0) - start) < 1e-6);
         // From the rim's circle (the float radius and half height) to the start: about (1, 1) / sqrt(2).
         const glm::dvec3 rim_normal =
@@ -393,7 +403,7 @@ TEST_CASE("colliders a particle too fast for one substep does not pass through t
     // A glancing path that stays in the thickness shell (a particle sliding over the top face) is not a pass.
     State slide = test::free_particles({{0.01f, 0.2f + thickness, 0.0f}}, 0.01f);
     slide.motion.set(0, {0.02f, 0.0f, 0.0f});
-    collide(slide, cylinder, thickness);
+    collide(slide, frictionless(cylinder), thickness);
     CHECK(slide.position.get(0).x == Approx(0.01f));
     CHECK(slide.motion.get(0).x == Approx(0.02f));
 }
@@ -403,9 +413,9 @@ TEST_CASE("colliders friction on the cylinder's top face slows sliding at mu g a
     // A wide disc (radius 0.5) so the particle stops on it: at most 0.255 m from x = -0.4 at 1 m/s.
     const float v0 = 1.0f;
     auto sliding = [&](float mu) {
-        const CylinderCollider cylinder{true, {0.0f, 0.1f, 0.0f}, 0.5f, 0.2f, mu};
+        const Collider cylinder{CylinderCollider{{0.0f, 0.1f, 0.0f}, 0.5f, 0.2f}, mu, true};
         Scene s = lone_particle({-0.4f, 0.2f + 0.005f, 0.0f}, {v0, 0.0f, 0.0f}, 20);
-        s.settings.colliders.cylinder = cylinder;
+        test::collider(s.settings.colliders, "cylinder") = cylinder;
         return build_simulation(s);
     };
     {
@@ -436,7 +446,7 @@ TEST_CASE("colliders a cloth drapes over the cylinder: none inside, on the top f
         Scene scene = drape_on_cylinder();
         apply_override(scene, std::string("integration.integrator=") + integrator);
         MassSpring sim = build_simulation(scene);
-        const CylinderCollider& c = scene.settings.colliders.cylinder;
+        const CylinderCollider& c = test::cylinder(scene.settings.colliders);
         const float top = c.center.y + 0.5f * c.height, thickness = scene.settings.colliders.thickness;
         float worst = INFINITY;
         for (int step = 0; step < 180; ++step) {  // 3 s: falls, hits, drapes, settles

@@ -43,15 +43,15 @@ Scene particle_over_ground(double y, float damping, Integrator integrator, Solve
 // m: how deep the particle is in the ground's shell (thickness minus height).
 double depth(const MassSpring& sim) { return double(sim.settings().colliders.thickness) - sim.state().position.y[0]; }
 
-// A Cusick support (radius 0.09) standing on y = 0, top face at y = 0.5; no ground.
-constexpr CylinderCollider kSupport{true, {0.0f, 0.25f, 0.0f}, 0.09f, 0.5f, 0.0f};
+// A Cusick support (radius 0.09) standing on y = 0, top face at y = 0.5, frictionless; no ground.
+constexpr CylinderCollider kSupport{{0.0f, 0.25f, 0.0f}, 0.09f, 0.5f};
 
 // The undamped particle of particle_over_ground at (x, y, 0) over the support instead of the ground.
 Scene particle_over_cylinder(double x, double y, int substeps) {
     Scene s = particle_over_ground(y, 0.0f, Integrator::Rk4, SolverMethod::Textbook, substeps);
     s.cloth.origin.x = static_cast<float>(x);
-    s.settings.colliders.ground.enabled = false;
-    s.settings.colliders.cylinder = kSupport;
+    test::collider(s.settings.colliders, "ground").enabled = false;
+    test::collider(s.settings.colliders, "cylinder") = Collider{kSupport, 0.0f, true};
     return s;
 }
 
@@ -94,8 +94,8 @@ TEST_CASE("penalty contact force and potential follow k p^3 / t^2 and k p^4 / (4
     CHECK(force.get(0) == glm::dvec3(0.0));
 
     // The sphere pushes along its normal, the same depth as the projection's (radius + t - distance).
-    colliders.ground.enabled = false;
-    colliders.sphere = {true, {0.0f, 0.0f, 0.0f}, 0.5f, 0.0f};
+    test::collider(colliders, "ground").enabled = false;
+    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.0f, 0.0f}, 0.5f}, 0.0f, true};
     state.pinned[0] = 0;
     const glm::dvec3 dir = glm::normalize(glm::dvec3(1.0, 2.0, -2.0));
     state.position.set(0, dir * (0.5 + t - p));
@@ -107,9 +107,10 @@ TEST_CASE("penalty contact force and potential follow k p^3 / t^2 and k p^4 / (4
 
     // The cylinder pushes at the same depth (thickness less the distance to the solid) along the normal of
     // its nearest point: up from the top face, out from the side, and from a rim along the diagonal.
-    colliders.sphere.enabled = false;
-    colliders.cylinder = {true, {0.0f, 0.0f, 0.0f}, 0.5f, 1.0f, 0.0f};  // top face y = 0.5, side r = 0.5
-    const double top = 0.5 * double(colliders.cylinder.height), side = double(colliders.cylinder.radius);
+    test::collider(colliders, "sphere").enabled = false;
+    // top face y = 0.5, side r = 0.5
+    test::collider(colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.0f, 0.0f}, 0.5f, 1.0f}, 0.0f, true};
+    const double top = 0.5 * double(test::cylinder(colliders).height), side = double(test::cylinder(colliders).radius);
     const glm::dvec3 around = glm::normalize(glm::dvec3(1.0, 0.0, -2.0));  // a direction around the axis
     const glm::dvec3 rim_dir = glm::normalize(glm::dvec3(3.0, 4.0, 0.0));
     struct Probe {
@@ -269,8 +270,8 @@ TEST_CASE("penalty contact: fast and textbook solvers give bit-identical drapes"
     CHECK(test::bit_identical(fast, textbook));
 
     // The same with a cylinder in the sphere's place, its top face where the sphere's top is.
-    scene.settings.colliders.sphere.enabled = false;
-    scene.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.0f};
+    test::collider(scene.settings.colliders, "sphere").enabled = false;
+    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.0f, true};
     const MassSpring fast_cylinder = run(SolverMethod::Fast);
     const MassSpring textbook_cylinder = run(SolverMethod::Textbook);
     CHECK(fast_cylinder.energy().contact_potential > 0.0);  // the cloth is on the cylinder
@@ -316,7 +317,7 @@ TEST_CASE("penalty contact: the stability limit counts 3 k_c per enabled collide
     // The cylinder counts as one more collider: 3 k_c more.
     settings.integration.integrator = Integrator::Verlet;
     settings.colliders.contact = ContactModel::Penalty;
-    settings.colliders.cylinder.enabled = true;
+    test::collider(settings.colliders, "cylinder").enabled = true;
     const StabilityLimit three = stability_limit(sim.topology(), sim.state(), settings);
     CHECK(three.omega_gershgorin * three.omega_gershgorin ==
           Approx(projection.omega_gershgorin * projection.omega_gershgorin + 1.5 * added).epsilon(1e-9));
@@ -335,7 +336,7 @@ TEST_CASE("penalty contact: a drape at the predicted limit stays finite and out 
     test::edit_settings(sim, [&](SimulationSettings& s) { s.integration.substeps = substeps; });
     sim.run_steps(90);  // 1.5 s: falls onto the sphere and drapes
     REQUIRE(sim.all_finite());
-    const SphereCollider& sphere = scene.settings.colliders.sphere;
+    const SphereCollider& sphere = test::sphere(scene.settings.colliders);
     double closest = 1e9;
     for (std::size_t i = 0; i < sim.particle_count(); ++i) {
         closest = std::min(closest, static_cast<double>(signed_distance(sphere, sim.position(i))));

@@ -83,7 +83,7 @@ TEST_CASE("drape: the bundled cusick scene settles to folds and a drape coeffici
     MassSpring sim = build_simulation(s);
     sim.run_steps(180);  // 3 s: settled to a kinetic energy of 1e-7 J
     REQUIRE(sim.all_finite());
-    const CylinderCollider& c = s.settings.colliders.cylinder;
+    const CylinderCollider& c = test::cylinder(s.settings.colliders);
     const DrapeFigures d = measure_drape(sim, glm::dvec3(c.center), c.radius);
     INFO("DC " << d.drape_coefficient << ", folds " << d.folds);
     CHECK(d.drape_coefficient > 0.3);

@@ -128,15 +128,16 @@ TEST_CASE("fast solver agrees with the textbook solver bit for bit on a cloth dr
     // (the fast solver's block boxes) and the cylinder's projection with friction and continuous collision.
     // Per spring: at its 38 substeps a step 1000 substeps are 0.44 s, enough to fall that far.
     Scene scene = per_spring_scene("drape-sphere");
-    scene.settings.colliders.sphere.enabled = false;
-    scene.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
+    test::collider(scene.settings.colliders, "sphere").enabled = false;
+    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
     const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
-    const CylinderCollider& c = scene.settings.colliders.cylinder;
+    const CylinderCollider& c = test::cylinder(scene.settings.colliders);
     for (int threads : {1, 2, 3}) {
         INFO(threads << " threads");
         const MassSpring fast = run(scene, SolverMethod::Fast, threads, 1000);
         CHECK(fast.plan().path == StepPath::Fast);
-        CHECK(fast.profile().runs_of(Stage::Cylinder) == 1000);
+        CHECK(fast.profile().runs_of(Stage::Colliders) == 1000);
+        CHECK(fast.profile().blocks_offered[2] > 0);  // the cylinder (kind 2) was tested
         CHECK(fast.all_finite());
         CHECK(test::bit_identical(fast, textbook));
     }
@@ -159,9 +160,9 @@ TEST_CASE("fast solver keeps pins fixed and every particle outside the colliders
     CHECK(sim.position(39 * 40 + 39) == b);
     for (std::size_t i = 0; i < sim.particle_count(); ++i) {
         if (sim.particle(i).pinned) continue;
-        CHECK(glm::length(sim.position(i) - scene.settings.colliders.sphere.center) >=
-              scene.settings.colliders.sphere.radius);
-        CHECK(sim.position(i).y >= scene.settings.colliders.ground.height);
+        CHECK(glm::length(sim.position(i) - test::sphere(scene.settings.colliders).center) >=
+              test::sphere(scene.settings.colliders).radius);
+        CHECK(sim.position(i).y >= test::plane(scene.settings.colliders).height);
     }
 }
 
@@ -196,7 +197,7 @@ TEST_CASE("fast solver is only used for grid topologies; others run the textbook
     odd.cols = 3;
     odd.springs = {{0, 2, 2.0f, SpringKind::Structural}};
     SimulationSettings settings;
-    settings.colliders.ground.enabled = false;
+    test::collider(settings.colliders, "ground").enabled = false;
     settings.forces.gravity = glm::vec3(0.0f);
     MassSpring sim(odd, st, settings);
     CHECK_FALSE(sim.fast_solver_available());
@@ -345,12 +346,12 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
         });
         sim.step();
         for (int i = 0; i < 1500; ++i) sim.step();  // onto the sphere: collisions move particles
-        CHECK(sim.settings().colliders.sphere.enabled);
+        CHECK(test::collider(sim.settings().colliders, "sphere").enabled);
         double nearest = INFINITY;  // to the sphere's centre
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
-            nearest = std::min(nearest, double(glm::length(sim.position(i) - sim.settings().colliders.sphere.center)));
+            nearest = std::min(nearest, double(glm::length(sim.position(i) - test::sphere(sim.settings().colliders).center)));
         }
-        CHECK(nearest < sim.settings().colliders.sphere.radius + 2.0 * sim.settings().colliders.thickness);
+        CHECK(nearest < test::sphere(sim.settings().colliders).radius + 2.0 * sim.settings().colliders.thickness);
         return sim;
     };
     const MassSpring textbook = script(SolverMethod::Textbook, 1);

@@ -87,9 +87,9 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
     material.material.bending = {2e-5f, 5e-6f};
     material.settings.forces.wind = {1.0f, 0.0f, 3.0f};
     Scene disc = test::disc_specimen(15);
-    disc.settings.colliders.sphere.enabled = true;
-    disc.settings.colliders.sphere.center = {0.0f, 0.8f, 0.0f};
-    disc.settings.colliders.sphere.radius = 0.09f;
+    test::collider(disc.settings.colliders, "sphere").enabled = true;
+    test::sphere(disc.settings.colliders).center = {0.0f, 0.8f, 0.0f};
+    test::sphere(disc.settings.colliders).radius = 0.09f;
     const std::pair<const char*, Scene> cases[] = {
         {"per-spring hanging", xpbd_scene(per_spring_scene("hanging"), 13, 11, 8)},
         {"per-spring drape-sphere", xpbd_scene(per_spring_scene("drape-sphere"), 10, 17, 4)},
@@ -162,7 +162,7 @@ TEST_CASE("grid XPBD keeps the centre of mass of a free cloth without external f
     s.pins.particles.clear();
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
     s.settings.springs.damping = 0.0f;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     MassSpring sim = build_simulation(s);
     // Stretch it unevenly (a shear and a bulge), at rest.
     for (std::size_t i = 0; i < sim.particle_count(); ++i) {

@@ -142,8 +142,8 @@ TEST_CASE("integrators all keep pins fixed and particles outside the colliders",
         CHECK(sim.all_finite());
         CHECK(sim.position(0) == pin);
         for (std::size_t i = 1; i < sim.particle_count(); ++i) {
-            CHECK(signed_distance(s.settings.colliders.sphere, sim.position(i)) >= 0.0f);
-            CHECK(signed_distance(s.settings.colliders.ground, sim.position(i)) >= 0.0f);
+            CHECK(signed_distance(test::sphere(s.settings.colliders), sim.position(i)) >= 0.0f);
+            CHECK(signed_distance(test::plane(s.settings.colliders), sim.position(i)) >= 0.0f);
         }
     }
 }
@@ -162,7 +162,7 @@ TEST_CASE("integrators XPBD reports its constraint residual: none for one spring
     // A cloth: each projection disturbs its neighbours, so one Gauss-Seidel pass leaves a residual.
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 12;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.integration.integrator = Integrator::Xpbd;
     MassSpring cloth = build_simulation(s);
     cloth.run_steps(10);

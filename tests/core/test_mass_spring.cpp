@@ -45,7 +45,7 @@ TEST_CASE("mass_spring total momentum of a free cloth with springs only stays co
     s.pins.preset = PinPreset::None;
     s.settings.forces.gravity = glm::vec3(0.0f);
     s.settings.springs.damping = 0.0f;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     MassSpring sim = build_simulation(s);
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> jitter(-0.02f, 0.02f), speed(-1.0f, 1.0f);
@@ -147,7 +147,7 @@ TEST_CASE("mass_spring zero-length springs and coincident particles stay finite"
     const State st = test::free_particles({glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)}, 1.0f);
     SimulationSettings settings;
     settings.forces.gravity = glm::vec3(0.0f);
-    settings.colliders.ground.enabled = false;
+    test::collider(settings.colliders, "ground").enabled = false;
     MassSpring sim(t, st, settings);
     sim.run_steps(10);
     CHECK(sim.all_finite());

@@ -2,6 +2,7 @@
 #include "clothsim/material.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
+#include "support.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -63,7 +64,7 @@ double cantilever_drop(int along, double length, double width, double bending, d
     s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
     s.pins.preset = PinPreset::None;
     for (int r = 0; r < s.cloth.rows; ++r) s.pins.particles.push_back({r, 0}), s.pins.particles.push_back({r, 1});
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     // Mass-proportional damping at critical for the first mode, w1 = 3.516 sqrt(B / (density L^4)) (9 rad/s at
     // B = 1e-4 N m, 91 at 1e-2), settles the strip to e^-20 in 20 / w1; it does not change the static shape.
     // Skip-one springs are far floppier than bends at small curvature: they settle from a slower, larger
@@ -160,7 +161,7 @@ Tensile tensile_test(int per_side, bool along_u, glm::vec2 stretch, float shear)
     s.cloth.v_axis = {0.0f, 1.0f, 0.0f};
     s.pins.preset = along_u ? PinPreset::LeftEdge : PinPreset::TopRow;
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.solver.sleep_speed = 0.0f;
     s.material.enabled = true;
     s.material.density = 0.15f;
@@ -425,7 +426,7 @@ std::vector<glm::dvec3> hanging_settled(int n, double seconds = 5.0, float clip 
     s.material.bending = glm::vec2(bending);
     s.pins.preset_radius = clip;
     s.settings.springs.tether_strain = tethers;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.damping = damping;  // 6: 2 sqrt(g / L), the slowest swing at critical
     s.settings.solver.sleep_speed = 0.0f;
     s.settings.solver.threads = 1;

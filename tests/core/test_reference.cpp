@@ -19,7 +19,7 @@ namespace {
 Scene smooth_scene() {
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 16;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.damping = 0.0f;
     return s;
 }

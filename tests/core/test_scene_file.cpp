@@ -17,6 +17,7 @@
 #include <string>
 #include <type_traits>
 #include <typeinfo>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -59,6 +60,18 @@ std::string allowed(std::string_view field) {
     const clothsim::FieldInfo* f = clothsim::find_field(field);
     REQUIRE(f != nullptr);
     return clothsim::describe_allowed(*f);
+}
+
+// The same for a collider's field, by its first-form name: allowed_collider("cylinder", "radius") for
+// colliders.cylinder.radius (collider fields are rows of their kind, not entries of the field table).
+std::string allowed_collider(std::string_view kind, std::string_view field) {
+    const int k = clothsim::find_collider_kind(kind);
+    REQUIRE(k >= 0);
+    for (const clothsim::ColliderField& f : clothsim::collider_fields_of_kind(static_cast<std::size_t>(k))) {
+        if (f.name == field) return clothsim::describe_allowed(f);
+    }
+    FAIL("kind " << kind << " has no field " << field);
+    return {};
 }
 
 // Shortest decimal text of a double that reads back to it.
@@ -384,8 +397,8 @@ TEST_CASE("scene file: a valid file from disk loads") {
     CHECK(s.pins.preset == clothsim::PinPreset::TopRow);
     CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{2, 1}});
     CHECK(s.cloth.size == glm::vec2(0.5f, 0.5f));
-    CHECK(s.settings.colliders.sphere.enabled);
-    CHECK(s.settings.colliders.sphere.radius == 0.25f);
+    CHECK(clothsim::test::collider(s.settings.colliders, "sphere").enabled);
+    CHECK(clothsim::test::sphere(s.settings.colliders).radius == 0.25f);
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Uniform);
     const clothsim::MassSpring sim = clothsim::build_simulation(s);
     CHECK(sim.particle_count() == 6);
@@ -440,9 +453,9 @@ TEST_CASE("scene override: ints, floats, vectors, booleans, strings and bare wor
     CHECK(s.settings.forces.wind == glm::vec3(1.5f, 0.0f, -2.0f));
 
     clothsim::apply_override(s, "colliders.sphere.enabled=true");
-    CHECK(s.settings.colliders.sphere.enabled);
+    CHECK(clothsim::test::collider(s.settings.colliders, "sphere").enabled);
     clothsim::apply_override(s, "colliders.ground.enabled=false");
-    CHECK_FALSE(s.settings.colliders.ground.enabled);
+    CHECK_FALSE(clothsim::test::collider(s.settings.colliders, "ground").enabled);
 
     clothsim::apply_override(s, "pins=top-row");
     CHECK(s.pins.preset == clothsim::PinPreset::TopRow);
@@ -919,18 +932,22 @@ TEST_CASE("scene clamp_to_range: every field typed far out of range is clamped w
 
 TEST_CASE("scene file: the cylinder collider loads, overrides, round-trips and rejects bad values") {
     using namespace clothsim;
-    CHECK_FALSE(Scene{}.settings.colliders.cylinder.enabled);  // off unless a scene asks for it
+    const std::vector<Collider>& defaults = Scene{}.settings.colliders.shapes;
+    CHECK(std::none_of(defaults.begin(), defaults.end(), [](const Collider& x) {
+        return std::holds_alternative<CylinderCollider>(x.shape) && x.enabled;
+    }));  // off unless a scene asks for it
     const Scene s = parse_scene("[colliders.cylinder]\nenabled = true\ncenter = [0.1, 0.25, -0.2]\n"
                                 "radius = 0.09\nheight = 0.5\nfriction = 0.45\n",
                                 "test.toml");
-    const CylinderCollider& c = s.settings.colliders.cylinder;
-    CHECK(c.enabled);
+    const Collider& collider = test::collider(s.settings.colliders, "cylinder");
+    const CylinderCollider& c = test::cylinder(s.settings.colliders);
+    CHECK(collider.enabled);
     CHECK(c.center == glm::vec3(0.1f, 0.25f, -0.2f));
     CHECK(c.radius == 0.09f);
     CHECK(c.height == 0.5f);
-    CHECK(c.friction == 0.45f);
+    CHECK(collider.friction == 0.45f);
     const std::string text = to_toml(s);
-    CHECK_THAT(text, Contains("[colliders.cylinder]") && Contains("radius = 0.09") && Contains("height = 0.5"));
+    CHECK_THAT(text, Contains("kind = \"cylinder\"") && Contains("radius = 0.09") && Contains("height = 0.5"));
     CHECK(parse_scene(text, "saved.toml").settings == s.settings);
 
     Scene o;
@@ -939,16 +956,17 @@ TEST_CASE("scene file: the cylinder collider loads, overrides, round-trips and r
     apply_override(o, "colliders.cylinder.radius=0.09");
     apply_override(o, "colliders.cylinder.height=0.6");
     apply_override(o, "colliders.cylinder.friction=0");
-    CHECK(o.settings.colliders.cylinder == CylinderCollider{true, {0.0f, 0.3f, 0.0f}, 0.09f, 0.6f, 0.0f});
+    CHECK(test::collider(std::as_const(o.settings.colliders), "cylinder") ==
+          Collider{CylinderCollider{{0.0f, 0.3f, 0.0f}, 0.09f, 0.6f}, 0.0f, true});
 
     const std::string height = parse_error("[colliders.cylinder]\nheight = -0.1\n");
     CHECK_THAT(height, Contains("test.toml:2:") && Contains("colliders.cylinder.height") &&
                            Contains("a number in [0.0, 10000.0] m"));
     Scene unchanged = o;
     CHECK_THAT(override_error(unchanged, "colliders.cylinder.radius=-1"),
-               Contains("colliders.cylinder.radius") && Contains(allowed("colliders.cylinder.radius")));
+               Contains("colliders.cylinder.radius") && Contains(allowed_collider("cylinder", "radius")));
     CHECK_THAT(override_error(unchanged, "colliders.cylinder.friction=11"),
-               Contains("colliders.cylinder.friction") && Contains(allowed("colliders.cylinder.friction")));
+               Contains("colliders.cylinder.friction") && Contains(allowed_collider("cylinder", "friction")));
     CHECK(unchanged.settings == o.settings);
 }
 

@@ -183,7 +183,7 @@ TEST_CASE("sleep never freezes a cloth moving faster than sleep_speed", "[sleep]
     // Falling freely (no ground, no pins): it only gets faster.
     Scene falling = settling_scene();
     falling.pins.preset = PinPreset::None;
-    falling.settings.colliders.ground.enabled = false;
+    test::collider(falling.settings.colliders, "ground").enabled = false;
     falling.settings.springs.damping = 0.2f;
     MassSpring sim = build_simulation(falling);
     REQUIRE(sim.plan().may_sleep);
@@ -227,7 +227,7 @@ TEST_CASE("sleep with sleep_time 0 a cloth moving faster than sleep_speed still 
     // the first check whatever the speed".
     Scene falling = settling_scene();
     falling.pins.preset = PinPreset::None;
-    falling.settings.colliders.ground.enabled = false;
+    test::collider(falling.settings.colliders, "ground").enabled = false;
     falling.settings.solver.sleep_time = 0.0f;
     MassSpring sim = build_simulation(falling);
     falling.settings.solver.sleep_speed = 0.0f;
@@ -250,7 +250,7 @@ TEST_CASE("sleep a cloth with NaN motion never sleeps, wherever the NaN particle
         t.cols = 2;
         SimulationSettings settings;
         settings.forces.gravity = glm::vec3(0.0f);
-        settings.colliders.ground.enabled = false;
+        test::collider(settings.colliders, "ground").enabled = false;
         settings.solver.sleep_speed = 0.002f;
         settings.solver.sleep_time = 0.5f;
         MassSpring sim(t, test::free_particles({{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}}, 1.0f), settings);
@@ -327,19 +327,19 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
         const std::vector<glm::vec3> held = sim.positions();
         float lowest = INFINITY;
         for (const glm::vec3& p : held) lowest = std::min(lowest, p.y);
-        test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.ground.height = lowest + 0.05f; });
+        test::edit_settings(sim, [&](SimulationSettings& edit) { test::plane(edit.colliders).height = lowest + 0.05f; });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
         CHECK(largest_move(sim, held) > 0.04f);
     }
     SECTION("a sphere moved into the cloth") {
         Scene scene = settling_scene();
-        scene.settings.colliders.sphere = {true, {0.0f, 0.5f, 3.0f}, 0.2f, 0.3f};  // out of the way
+        test::collider(scene.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.5f, 3.0f}, 0.2f}, 0.3f, true};  // out of the way
         MassSpring sim = build_simulation(scene);
         settle(sim);
         const std::vector<glm::vec3> held = sim.positions();
         const glm::vec3 middle = held[sim.topology().index(4, 4)];
-        test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.sphere.center = middle + glm::vec3(0.0f, 0.0f, 0.15f); });
+        test::edit_settings(sim, [&](SimulationSettings& edit) { test::sphere(edit.colliders).center = middle + glm::vec3(0.0f, 0.0f, 0.15f); });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
         CHECK(largest_move(sim, held) > 0.01f);
@@ -347,7 +347,7 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
     SECTION("a collider moved out of reach still wakes it") {
         MassSpring sim = asleep_cloth();
         // A disabled sphere: nothing touches the cloth.
-        test::edit_settings(sim, [](SimulationSettings& edit) { edit.colliders.sphere.center.x += 1.0f; });
+        test::edit_settings(sim, [](SimulationSettings& edit) { test::sphere(edit.colliders).center.x += 1.0f; });
         sim.run_steps(1);
         CHECK_FALSE(sim.asleep());
     }

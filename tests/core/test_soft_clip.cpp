@@ -32,7 +32,7 @@ Scene clipped_sheet(int n, int row, int col, float radius, ClipHold clip) {
     s.settings.springs.bending = glm::vec2(0.5f);
     s.settings.springs.damping = 0.0f;
     s.settings.springs.tether_strain = 0.0f;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.solver.sleep_speed = 0.0f;
     s.pins.preset = PinPreset::None;
     s.pins.particles = {PinClip{row, col, radius}};
@@ -45,7 +45,7 @@ Scene clipped_sheet(int n, int row, int col, float radius, ClipHold clip) {
 Scene hanging_clipped(int n, ClipHold clip) {
     Scene s = load_scene("hanging");
     s.cloth.rows = s.cloth.cols = n;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.damping = 2.0f;
     s.settings.springs.tether_strain = 0.0f;
     s.settings.solver.sleep_speed = 0.0f;

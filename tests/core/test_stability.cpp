@@ -31,7 +31,7 @@ Scene free_grid(int n, float k) {
     s.pins.preset = PinPreset::None;
     s.settings.springs = {glm::vec2(k), 0.1f * k, glm::vec2(0.025f * k), 0.0f};
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.integration.substeps = 1;
     s.settings.solver.threads = 1;  // no spinning worker threads when the machine is busy
     return s;
@@ -711,7 +711,7 @@ TEST_CASE("stability a hand-built topology with zero-length springs runs finite"
                         {1, 2, 0.1f, SpringKind::Structural},
                         {2, 3, 0.2f, SpringKind::Shear}};
     SimulationSettings settings;
-    settings.colliders.ground.enabled = false;
+    test::collider(settings.colliders, "ground").enabled = false;
     settings.forces.gravity = {0.0f, 0.0f, 0.0f};
     MassSpring sim(topology, state, settings, {});
     REQUIRE_FALSE(sim.fast_solver_available());
@@ -793,10 +793,10 @@ TEST_CASE("stability a sphere around pinned particles: pinned stay put, free one
           "[stability]") {
     Scene s;
     s.cloth.rows = s.cloth.cols = 12;  // top corners (row 0) pinned at (-0.5, 1.5, 0) and (0.5, 1.5, 0)
-    s.settings.colliders.sphere = {true, {-0.5f, 1.5f, 0.0f}, 0.25f, 0.3f};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{-0.5f, 1.5f, 0.0f}, 0.25f}, 0.3f, true};
     MassSpring sim = build_simulation(s);
     const glm::vec3 pin0 = sim.position(0), pin1 = sim.position(11);
-    REQUIRE(signed_distance(s.settings.colliders.sphere, pin0) < 0.0f);
+    REQUIRE(signed_distance(test::sphere(s.settings.colliders), pin0) < 0.0f);
     const float thickness = s.settings.colliders.thickness;
     for (int step = 0; step < 60; ++step) {
         sim.run_steps(1);
@@ -804,7 +804,7 @@ TEST_CASE("stability a sphere around pinned particles: pinned stay put, free one
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {
             if (sim.particle(i).pinned) continue;
             INFO("step " << step << ", particle " << i);
-            CHECK(signed_distance(sim.settings().colliders.sphere, sim.position(i)) >= thickness - 1e-4f);
+            CHECK(signed_distance(test::sphere(sim.settings().colliders), sim.position(i)) >= thickness - 1e-4f);
         }
     }
     CHECK(sim.position(0) == pin0);
@@ -817,8 +817,8 @@ TEST_CASE("stability a sphere enclosing the whole cloth pushes every particle to
     s.cloth.rows = s.cloth.cols = 5;  // particle (2, 2) sits exactly at the centre (0, 1, 0)
     s.pins.preset = PinPreset::None;
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
-    s.settings.colliders.ground.enabled = false;
-    s.settings.colliders.sphere = {true, {0.0f, 1.0f, 0.0f}, 10.0f, 0.3f};
+    test::collider(s.settings.colliders, "ground").enabled = false;
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 10.0f}, 0.3f, true};
     MassSpring sim = build_simulation(s);
     REQUIRE(sim.position(12) == glm::vec3(0.0f, 1.0f, 0.0f));
     const float surface = 10.0f + s.settings.colliders.thickness;

@@ -23,7 +23,7 @@ constexpr float kStep = 1.0f / 60.0f;  // s: the bundled scenes' step
 Scene smooth_scene(int side) {
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = side;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.integration.dt = kStep;
     s.settings.integration.tolerance = 1e-6f;
     return s;

@@ -51,8 +51,8 @@ bool moved_from(const MassSpring& sim, const std::vector<glm::vec3>& start) {
 Scene drape_scene(const std::string& name) {
     if (name != "drape-cylinder") return per_spring_scene(name);
     Scene s = per_spring_scene("drape-sphere");
-    s.settings.colliders.sphere.enabled = false;
-    s.settings.colliders.cylinder = {true, {0.0f, 0.425f, 0.0f}, 0.3f, 0.85f, 0.4f};
+    test::collider(s.settings.colliders, "sphere").enabled = false;
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
     return s;
 }
 
@@ -85,6 +85,20 @@ const StageStatus& status_of(const std::vector<StageStatus>& statuses, Stage sta
     const auto it = std::find_if(statuses.begin(), statuses.end(), [&](const StageStatus& s) { return s.stage == stage; });
     REQUIRE(it != statuses.end());
     return *it;
+}
+
+// A collider kind's index in the profile's per-kind block counts (collider.hpp: ColliderShape).
+template <class Shape>
+std::size_t kind_of() {
+    return Collider::of(Shape{}).kind();
+}
+
+// The kinds the colliders stage tests under `plan`, as describe() lists them before the colon of its note
+// ("sphere, plane"); empty when the stage does not run.
+std::string projected_kinds(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings) {
+    const std::vector<StageStatus> statuses = describe(plan, topology, settings);
+    const StageStatus& colliders = status_of(statuses, Stage::Colliders);
+    return colliders.runs() ? colliders.note.substr(0, colliders.note.find(':')) : std::string();
 }
 
 }  // namespace
@@ -182,26 +196,29 @@ TEST_CASE("step_plan a collider out of reach changes nothing and the broad phase
         INFO(method_name(method) << " solver");
         Scene without = small_hanging(method);
         Scene far = without;
-        far.settings.colliders.sphere = {true, {0.0f, -50.0f, 0.0f}, 1.0f, 0.3f};
-        far.settings.colliders.cylinder = {true, {30.0f, 1.0f, 0.0f}, 1.0f, 2.0f, 0.3f};
+        test::collider(far.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, -50.0f, 0.0f}, 1.0f}, 0.3f, true};
+        test::collider(far.settings.colliders, "cylinder") =
+            Collider{CylinderCollider{{30.0f, 1.0f, 0.0f}, 1.0f, 2.0f}, 0.3f, true};
         MassSpring a = build_simulation(without);
         MassSpring b = build_simulation(far);
-        CHECK_FALSE(a.plan().sphere);
-        CHECK_FALSE(a.plan().cylinder);
-        CHECK(b.plan().sphere);
-        CHECK(b.plan().cylinder);
+        CHECK_FALSE(a.plan().solids);
+        CHECK(projected_kinds(a.plan(), a.topology(), a.settings()).find("sphere") == std::string::npos);
+        CHECK(projected_kinds(a.plan(), a.topology(), a.settings()).find("cylinder") == std::string::npos);
+        CHECK(b.plan().colliders);
+        CHECK(b.plan().solids);
+        CHECK(projected_kinds(b.plan(), b.topology(), b.settings()).find("sphere") != std::string::npos);
+        CHECK(projected_kinds(b.plan(), b.topology(), b.settings()).find("cylinder") != std::string::npos);
         step_n(a, 60);
         step_n(b, 60);
         require_same_positions(a, b);
         // Every block of the 12 x 12 grid offered every substep; none may touch a sphere 50 m below or a
         // cylinder 30 m to the side.
-        for (Stage stage : {Stage::Sphere, Stage::Cylinder}) {
-            INFO("stage " << stage_name(stage));
-            const int c = collider_index(stage);
+        CHECK(b.profile().runs_of(Stage::Colliders) == 60);
+        for (std::size_t c : {kind_of<SphereCollider>(), kind_of<CylinderCollider>()}) {
+            INFO("kind " << collider_kind_names()[c]);
             CHECK(b.profile().blocks_offered[c] == static_cast<long long>(12 * blocks_per_row(12) * 60));
             CHECK(b.profile().blocks_tested[c] == 0);
-            CHECK(b.profile().runs_of(stage) == 60);
-            CHECK(a.profile().runs_of(stage) == 0);
+            CHECK(a.profile().blocks_offered[c] == 0);
         }
     }
 }
@@ -223,8 +240,11 @@ TEST_CASE("step_plan the collision broad phase on or off gives bit-identical dra
             full.run_steps(60);
             require_same_positions(culled, full);
             const ColliderSettings& c = culled.settings().colliders;
-            const Stage stage = c.sphere.enabled ? Stage::Sphere : c.cube.enabled ? Stage::Cube : Stage::Cylinder;
-            const int which = collider_index(stage);
+            // The scene's solid shape (the sphere, the cube or the cylinder).
+            const auto solid = std::find_if(c.shapes.begin(), c.shapes.end(),
+                                            [](const Collider& x) { return x.enabled && !is_half_space(x); });
+            REQUIRE(solid != c.shapes.end());
+            const std::size_t which = solid->kind();
             const StepProfile& pc = culled.profile();
             const StepProfile& pf = full.profile();
             INFO("blocks tested " << pc.blocks_tested[which] << " of " << pc.blocks_offered[which]);
@@ -234,15 +254,13 @@ TEST_CASE("step_plan the collision broad phase on or off gives bit-identical dra
             CHECK(pc.blocks_tested[which] < pc.blocks_offered[which]);
             CHECK(pf.blocks_tested[which] == pf.blocks_offered[which]);
             CHECK(pf.blocks_offered[which] == pc.blocks_offered[which]);
-            const int ground = collider_index(Stage::Ground);
+            const std::size_t ground = kind_of<PlaneCollider>();
             CHECK(pf.blocks_tested[ground] == pf.blocks_offered[ground]);  // the ground too
             // Draped: some particles rest on the collider.
             float closest = INFINITY;
             for (std::size_t i = 0; i < culled.particle_count(); ++i) {
                 const glm::vec3 p = culled.position(i);
-                closest = std::min(closest, stage == Stage::Sphere ? signed_distance(c.sphere, p)
-                                            : stage == Stage::Cube ? signed_distance(c.cube, p)
-                                                                   : signed_distance(c.cylinder, p));
+                closest = std::min(closest, signed_distance(*solid, p));
             }
             CHECK(closest < 2.0f * c.thickness);
         }
@@ -275,15 +293,16 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     const MassSpring sim = build_simulation(small_hanging(SolverMethod::Fast));
     const Topology& t = sim.topology();
     SimulationSettings s = sim.settings();
-    s.colliders.sphere.enabled = false;
-    s.colliders.cube.enabled = false;
-    s.colliders.ground.enabled = false;
+    test::collider(s.colliders, "sphere").enabled = false;
+    test::collider(s.colliders, "cube").enabled = false;
+    test::collider(s.colliders, "ground").enabled = false;
 
     StepPlan p = plan_step(t, s, true);
     CHECK(p.path == StepPath::Fast);
     CHECK(p.spring_mask() == 7u);
     CHECK_FALSE(p.wind);
-    CHECK_FALSE(p.any_collider());
+    CHECK_FALSE(p.colliders);
+    CHECK_FALSE(p.solids);
     CHECK_FALSE(p.strain_limit);
     CHECK_FALSE(p.speed_limit);
     CHECK_FALSE(p.may_sleep);  // small_hanging turns sleeping off
@@ -306,22 +325,25 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     CHECK(plan_step(t, s, true).speed_limit);
     s.forces.max_speed = 0.0f;
 
-    s.colliders.sphere.enabled = true;
+    test::collider(s.colliders, "sphere").enabled = true;
     p = plan_step(t, s, true);
-    CHECK((p.sphere && !p.cube && !p.ground));
-    s.colliders.sphere.enabled = false;
-    s.colliders.cube.enabled = true;
+    CHECK((p.colliders && p.solids));
+    CHECK(projected_kinds(p, t, s) == "sphere");
+    test::collider(s.colliders, "sphere").enabled = false;
+    test::collider(s.colliders, "cube").enabled = true;
     p = plan_step(t, s, true);
-    CHECK((!p.sphere && p.cube && !p.ground));
-    s.colliders.cube.enabled = false;
-    s.colliders.cylinder.enabled = true;
+    CHECK((p.colliders && p.solids));
+    CHECK(projected_kinds(p, t, s) == "box");
+    test::collider(s.colliders, "cube").enabled = false;
+    test::collider(s.colliders, "cylinder").enabled = true;
     p = plan_step(t, s, true);
-    CHECK((!p.sphere && !p.cube && p.cylinder && !p.ground));
-    CHECK(p.any_collider());
-    s.colliders.cylinder.enabled = false;
-    s.colliders.ground.enabled = true;
+    CHECK((p.colliders && p.solids));
+    CHECK(projected_kinds(p, t, s) == "cylinder");
+    test::collider(s.colliders, "cylinder").enabled = false;
+    test::collider(s.colliders, "ground").enabled = true;
     p = plan_step(t, s, true);
-    CHECK((!p.sphere && !p.cube && !p.cylinder && p.ground));
+    CHECK((p.colliders && !p.solids));
+    CHECK(projected_kinds(p, t, s) == "plane");
 
     s.springs.shear = 0.0f;
     CHECK(plan_step(t, s, true).spring_mask() == 5u);
@@ -353,11 +375,12 @@ TEST_CASE("step_plan a setting applied to a live simulation replans at the point
     CHECK(sim.plan().path == StepPath::Fast);
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.strain_limit = 0.1f; });
-    test::edit_settings(sim, [&](SimulationSettings& edit) { edit.colliders.sphere.enabled = true; });
+    test::edit_settings(sim, [&](SimulationSettings& edit) { test::collider(edit.colliders, "sphere").enabled = true; });
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = Integrator::Rk4; });
     sim.step();
     CHECK(sim.plan().strain_limit);
-    CHECK(sim.plan().sphere);
+    CHECK(sim.plan().solids);
+    CHECK(projected_kinds(sim.plan(), sim.topology(), sim.settings()).find("sphere") != std::string::npos);
     CHECK(sim.plan().path == StepPath::VelocityIntegrator);
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = Integrator::Verlet; });
@@ -400,8 +423,9 @@ TEST_CASE("step_plan describe lists every stage once and names the setting that 
         const StageStatus& sleep = status_of(statuses, Stage::Sleep);
         CHECK(sleep.state == StageState::Skipped);
         CHECK(sleep.note.find("solver.sleep_speed") != std::string::npos);
-        CHECK(status_of(statuses, Stage::Sphere).state == StageState::Skipped);
-        CHECK(status_of(statuses, Stage::Ground).state == StageState::Runs);
+        // The colliders stage runs for the ground, not for the sphere.
+        CHECK(status_of(statuses, Stage::Colliders).state == StageState::Runs);
+        CHECK(projected_kinds(sim.plan(), sim.topology(), sim.settings()) == "plane");
         // The springs' note says which kinds run and why bending does not.
         const StageStatus& springs = status_of(statuses, Stage::Springs);
         INFO("springs: " << springs.note);
@@ -443,24 +467,30 @@ TEST_CASE("step_plan the profile counts each stage that runs once per substep an
     scene.settings.forces.wind = glm::vec3(0.0f);
     scene.settings.springs.strain_limit = 0.0f;
     scene.settings.forces.max_speed = 0.0f;
-    REQUIRE(scene.settings.colliders.ground.enabled);
+    REQUIRE(test::collider(scene.settings.colliders, "ground").enabled);
     MassSpring sim = build_simulation(scene);
     step_n(sim, kSubsteps);
     const StepProfile& p = sim.profile();
     CHECK(p.substeps == kSubsteps);
     CHECK(p.slept_substeps == 0);
     for (Stage skipped : {Stage::Wind, Stage::StrainLimit, Stage::SpeedLimit, Stage::Springs, Stage::Integrate,
-                          Stage::Sphere, Stage::Cube, Stage::Cylinder, Stage::Sleep}) {
+                          Stage::Sleep}) {
         INFO("stage " << stage_name(skipped));
         CHECK(p.runs_of(skipped) == 0);
         CHECK(p.ms_of(skipped) == 0.0);
     }
-    for (Stage runs : {Stage::Fast, Stage::Ground}) {
+    for (Stage runs : {Stage::Fast, Stage::Colliders}) {
         INFO("stage " << stage_name(runs));
         CHECK(p.runs_of(runs) == kSubsteps);
         CHECK(p.ms_of(runs) > 0.0);
     }
-    CHECK(p.blocks_offered[collider_index(Stage::Ground)] == static_cast<long long>(12 * blocks_per_row(12) * kSubsteps));
+    // The colliders stage tests the ground only: no block is offered to a sphere, a box or a cylinder.
+    for (std::size_t kind : {kind_of<SphereCollider>(), kind_of<BoxCollider>(), kind_of<CylinderCollider>()}) {
+        INFO("kind " << collider_kind_names()[kind]);
+        CHECK(p.blocks_offered[kind] == 0);
+        CHECK(p.blocks_tested[kind] == 0);
+    }
+    CHECK(p.blocks_offered[kind_of<PlaneCollider>()] == static_cast<long long>(12 * blocks_per_row(12) * kSubsteps));
 
     // The textbook path times its spring and integration stages instead of the fast solver's fused stage.
     MassSpring textbook = build_simulation(small_hanging(SolverMethod::Textbook));
@@ -510,8 +540,8 @@ void check_describe_matches_profile(const MassSpring& sim) {
 Scene busy(SolverMethod method) {
     Scene s = small_hanging(method);
     s.settings.forces.wind = {0.0f, 0.0f, 2.0f};
-    s.settings.colliders.sphere = {true, {0.0f, 1.0f, 0.0f}, 0.3f, 0.3f};
-    s.settings.colliders.cylinder = {true, {0.3f, 0.6f, 0.0f}, 0.1f, 0.3f, 0.3f};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 0.3f}, 0.3f, true};
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.3f, 0.6f, 0.0f}, 0.1f, 0.3f}, 0.3f, true};
     s.settings.springs.strain_limit = 0.1f;
     s.settings.forces.max_speed = 20.0f;
     return s;
@@ -568,24 +598,25 @@ TEST_CASE("step_plan penalty contact runs the contact force stage instead of the
         MassSpring sim = build_simulation(scene);
         const StepPlan& plan = sim.plan();
         CHECK(plan.contact);
-        CHECK_FALSE(plan.any_collider());  // no sphere, cube or ground projection
+        CHECK_FALSE(plan.colliders);  // no sphere, cube or ground projection
         sim.run_steps(2);
         const long long substeps = 2LL * scene.settings.integration.substeps;
         CHECK(sim.profile().runs_of(Stage::Contact) == substeps);
-        for (Stage skipped : {Stage::Sphere, Stage::Cube, Stage::Cylinder, Stage::Ground, Stage::BroadPhase}) {
+        for (Stage skipped : {Stage::Colliders, Stage::BroadPhase}) {
             INFO("stage " << stage_name(skipped));
             CHECK(sim.profile().runs_of(skipped) == 0);
         }
         check_describe_matches_profile(sim);
         const std::vector<StageStatus> statuses = describe(sim.plan(), sim.topology(), sim.settings());
-        CHECK(status_of(statuses, Stage::Contact).note.find("sphere, ground") != std::string::npos);
-        CHECK(status_of(statuses, Stage::Sphere).note.find("colliders.contact is penalty") != std::string::npos);
-        CHECK(status_of(statuses, Stage::Cube).note.find("colliders.cube.enabled is false") != std::string::npos);
+        CHECK(status_of(statuses, Stage::Contact).note.find("sphere, plane") != std::string::npos);
+        CHECK(status_of(statuses, Stage::Contact).note.find("box") == std::string::npos);  // the cube is not enabled
+        CHECK(status_of(statuses, Stage::Colliders).note.find("colliders.contact is penalty") != std::string::npos);
 
         // Back to projection through the one call: the projection stages run again, the contact stage not.
         test::edit_settings(sim, [](SimulationSettings& s) { s.colliders.contact = ContactModel::Projection; });
         CHECK_FALSE(sim.plan().contact);
-        CHECK((sim.plan().sphere && sim.plan().ground));
+        CHECK((sim.plan().colliders && sim.plan().solids));
+        CHECK(projected_kinds(sim.plan(), sim.topology(), sim.settings()) == "sphere, plane");
         const std::vector<StageStatus> back = describe(sim.plan(), sim.topology(), sim.settings());
         CHECK(status_of(back, Stage::Contact).note == "colliders.contact is projection");
     }
@@ -606,12 +637,12 @@ TEST_CASE("step_plan penalty contact runs the contact force stage instead of the
 
     // The cylinder is one of the colliders the contact stage pushes with, and alone it is enough for one.
     SimulationSettings cylinder = rk4.settings();
-    cylinder.colliders.cylinder.enabled = true;
+    test::collider(cylinder.colliders, "cylinder").enabled = true;
     const std::vector<StageStatus> with = describe(plan_step(rk4.topology(), cylinder, true), rk4.topology(), cylinder);
-    CHECK(status_of(with, Stage::Contact).note.find("sphere, cylinder, ground") != std::string::npos);
-    CHECK(status_of(with, Stage::Cylinder).note.find("colliders.contact is penalty") != std::string::npos);
-    cylinder.colliders.sphere.enabled = cylinder.colliders.ground.enabled = false;
+    CHECK(status_of(with, Stage::Contact).note.find("sphere, cylinder, plane") != std::string::npos);
+    CHECK(status_of(with, Stage::Colliders).note.find("colliders.contact is penalty") != std::string::npos);
+    test::collider(cylinder.colliders, "sphere").enabled = test::collider(cylinder.colliders, "ground").enabled = false;
     const StepPlan only = plan_step(rk4.topology(), cylinder, true);
     CHECK(only.contact);
-    CHECK_FALSE(only.any_collider());
+    CHECK_FALSE(only.colliders);
 }

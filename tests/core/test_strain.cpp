@@ -57,7 +57,7 @@ PinStrain settled_hanging(int n, float clip_radius) {
     Scene s = per_spring_scene("hanging");  // the per-spring constants docs/MATERIAL.md's pin table used
     s.cloth.rows = n;
     s.cloth.cols = n;
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.damping = 2.0f;
     s.settings.integration.substeps = n + 2;  // 0.66 of the critical substep (Gershgorin) at each size
     s.pins.preset_radius = clip_radius;

@@ -160,7 +160,7 @@ TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {
 
 TEST_CASE("cutting: a stroke across a hanging sheet parts it there; the lower piece falls, the upper still hangs", "[tearing]") {
     Scene s = load_scene("hanging");
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.tether_strain = 0.0f;
     MassSpring sim = build_simulation(s);
     sim.run_steps(30);

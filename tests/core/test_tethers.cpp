@@ -117,7 +117,7 @@ TEST_CASE("tethers: on the fast solver's row blocks and threads the cloth is the
     // that missed a particle the tethers moved would leave it in the ground.
     test::with_every_kernel([] {
         Scene s = hanging(40, 0.001f);  // a tenth of the particles at their tethers' limit
-        s.settings.colliders.ground.height = 1.0f;  // the hem (0.6 m when hanging straight) lies on it
+        test::plane(s.settings.colliders).height = 1.0f;  // the hem (0.6 m when hanging straight) lies on it
         s.settings.solver.method = SolverMethod::Textbook;
         MassSpring textbook = build_simulation(s);
         REQUIRE(textbook.plan().path == StepPath::Textbook);
@@ -153,8 +153,8 @@ TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep
         for (bool sphere : {false, true}) {
             for (int threads : {1, 2, 3}) {
                 Scene s = hanging(40, 0.001f);
-                s.settings.colliders.ground.height = -10.0f;
-                s.settings.colliders.sphere = SphereCollider{sphere, {0.0f, 20.0f, 0.0f}, 1.0f, 0.3f};
+                test::plane(s.settings.colliders).height = -10.0f;
+                test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 20.0f, 0.0f}, 1.0f}, 0.3f, sphere};
                 s.settings.solver.threads = threads;
                 MassSpring fast = build_simulation(s);
                 REQUIRE(fast.plan().path == StepPath::Fast);
@@ -229,7 +229,7 @@ TEST_CASE("tethers: a tethered pendulum released level swings down with the spee
         s.pins = PinSpec{PinPreset::None, {PinClip{0, 0, 0.0f}}, 0.0f};
         s.settings.springs = {glm::vec2(0.0f), 0.0f, glm::vec2(0.0f), 0.0f};
         s.settings.springs.tether_strain = 0.01f;
-        s.settings.colliders.ground.enabled = false;
+        test::collider(s.settings.colliders, "ground").enabled = false;
         s.settings.integration.integrator = integrator;
         s.settings.integration.substeps = 200;
         MassSpring sim = build_simulation(s);

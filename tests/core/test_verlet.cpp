@@ -147,7 +147,7 @@ TEST_CASE("verlet energy error of an undamped cloth stays bounded and shrinks 4x
     s.cloth.mass = 0.2f;
     s.pins.preset = PinPreset::TopCorners;
     s.settings.springs = {glm::vec2(40.0f), 4.0f, glm::vec2(1.0f), 0.0f};
-    s.settings.colliders.ground.enabled = false;
+    test::collider(s.settings.colliders, "ground").enabled = false;
     auto drift = [&](int substeps) {
         s.settings.integration.substeps = substeps;
         MassSpring sim = build_simulation(s);

@@ -813,3 +813,23 @@ TEST_CASE("cli: --json reports the substeps that ran: auto substeps' choice and 
                Contains("at 1 substeps; rolled back, it held at " + std::to_string(doubled)));
     CHECK(g.at("substep").get<double>() == Approx(g.at("dt").get<double>() / doubled).epsilon(1e-6));
 }
+
+TEST_CASE("cli: a scene of two spheres, two boxes and a cylinder runs headless, its JSON naming every kind it tested") {
+    const RunResult r = run_clothsim({"--headless", "--scene", (kData / "scene_shapes.toml").string(), "--duration", "1", "--json"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    const nlohmann::json out = nlohmann::json::parse(r.out);
+    CHECK(out.at("finite") == true);
+    CHECK(out.at("blew_up") == false);
+    int found = 0;
+    for (const auto& s : out.at("profile").at("stages")) {
+        if (s.at("stage") != "colliders") continue;
+        ++found;
+        CHECK_THAT(s.at("note").get<std::string>(), StartsWith("2 spheres, 2 boxes, cylinder, plane: "));
+        for (const char* kind : {"sphere", "box", "cylinder", "plane"}) {
+            INFO(kind);
+            CHECK(s.at("blocks_tested").at(kind).get<long long>() > 0);  // the cloth lies on each kind
+        }
+    }
+    CHECK(found == 1);
+}

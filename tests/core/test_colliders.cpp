@@ -8,7 +8,9 @@
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
+#include <array>
 #include <cmath>
+#include <string>
 #include <variant>
 
 using namespace clothsim;
@@ -468,5 +470,32 @@ TEST_CASE("colliders a cloth drapes over the cylinder: none inside, on the top f
         CHECK(worst >= 0.0f);
         CHECK(on_top > 100);  // the disc of radius 0.3 under a 1.2 m, 40 x 40 cloth holds about 200
         CHECK(on_side > 0);
+    }
+}
+
+TEST_CASE("colliders a cloth dropped on two spheres, two boxes and a cylinder stays outside every one, every step, on every path", "[colliders]") {
+    const Scene loaded = load_scene_file(std::string(CLOTHSIM_TEST_DATA) + "/scene_shapes.toml");
+    const std::vector<Collider>& shapes = loaded.settings.colliders.shapes;
+    REQUIRE(shapes.size() == 6);  // as listed: sphere, sphere, box, box, cylinder, plane
+    std::array<int, kColliderKindCount> count{};
+    for (const Collider& c : shapes) ++count[c.kind()];
+    CHECK(count == std::array<int, kColliderKindCount>{2, 2, 1, 1});
+    for (const char* method : {"fast", "textbook"}) {
+        Scene scene = loaded;
+        apply_override(scene, std::string("solver.method=") + method);
+        MassSpring sim = build_simulation(scene);
+        const float thickness = scene.settings.colliders.thickness;
+        int touching = 0;  // particles within the thickness shell of a shape at the end: the cloth lies on them
+        for (int step = 0; step < 120; ++step) {
+            sim.run_steps(1);
+            for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+                for (const Collider& c : shapes) {
+                    INFO(method << ", step " << step << ", particle " << i << ", " << kind_name(c));
+                    REQUIRE(signed_distance(c, sim.position(i)) > thickness - 1e-4f);
+                    if (step == 119 && signed_distance(c, sim.position(i)) < 2.0f * thickness) ++touching;
+                }
+            }
+        }
+        CHECK(touching > 100);  // it came to rest on the shapes, not beside them
     }
 }

@@ -2,13 +2,13 @@
 // the textbook spring loop, one fast-solver substep (springs + integration + collisions fused), the
 // textbook Verlet update, collisions with a sphere the cloth lies on, and the renderer's vertex normals. And
 // what the fast solver's threads cost per substep with no work at all: the parallel region it opens each
-// substep against the barriers one region per step would need instead (docs/PERFORMANCE.md, session 17).
+// substep against the barriers one region per step would need instead (docs/PERFORMANCE.md).
 #include "clothsim/colliders.hpp"
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 #include "forces.hpp"
-#include "verlet.hpp"
+#include "integrators/verlet.hpp"
 
 #include "per_spring_scenes.hpp"
 

@@ -23,7 +23,7 @@
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
 #include "forces.hpp"
-#include "verlet.hpp"
+#include "integrators/verlet.hpp"
 
 #include "per_spring_scenes.hpp"
 

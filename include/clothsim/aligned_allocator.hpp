@@ -1,8 +1,7 @@
 // An allocator whose blocks start on a cache line (64 bytes), for the arrays the hot loops stream through.
-// With malloc's 16-byte alignment an array could start mid-line; a grid row of 64 or 128 columns is a
-// whole number of lines, so then every row did, and every 512-bit load of a row split two lines. Which
-// arrays did depended on where the heap put them: two identical simulations differed by 3% in speed
-// (docs/PERFORMANCE.md).
+// An array that starts mid-line (malloc aligns to 16 bytes) makes every row of a grid whose width is a whole
+// number of lines start mid-line too, and every 512-bit load of a row split two lines; where the heap puts
+// the arrays would then set the speed (docs/PERFORMANCE.md).
 #pragma once
 
 #include <cstddef>

@@ -1,9 +1,9 @@
-// MassSpring: a cloth of particles joined by Hooke springs, advanced by one of five integrators (position
-// Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD: Integrator in settings.hpp).
+// MassSpring: a cloth of particles joined by Hooke springs, advanced by one of six integrators (position
+// Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD, projective: the table in integrator.hpp).
 //
 // The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind, penalty contact, the user's grab), integrate (gravity and damping inside),
-// collide (the projection contact: sphere, cube, cylinder, ground), pull tethered particles back to their pins, limit strain and speed, and once per step see whether
+// collide (the projection contact with the scene's list of shapes: collider.hpp), pull tethered particles back to their pins, limit strain and speed, and once per step see whether
 // the cloth may sleep. colliders.contact picks penalty contact (a force) or projection (a stage after). Which of these stages
 // run is planned from the settings (step_plan.hpp); each one that runs is timed (step_profile.hpp).
 // Topology is fixed at construction. MassSpring owns the live settings: apply() changes them (stiffness,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "clothsim/collider.hpp"
+#include "clothsim/integrator.hpp"
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -26,25 +27,6 @@ enum class ClipHold { Rigid, Soft };
 
 // The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,
 // projective).
-enum class Integrator {
-    Verlet,           // position Verlet with physical damping: second order, symplectic (the default)
-    SymplecticEuler,  // semi-implicit Euler: v += h a, x += h v; first order, symplectic
-    Rk4,              // classical Runge-Kutta: fourth order, explicit
-    ImplicitEuler,    // backward Euler linearised once per step, CG on the spring Jacobian (Baraff-Witkin 1998)
-    Xpbd,             // extended position-based dynamics, one iteration per substep, compliance 1/k
-    Projective,       // BDF2 solved by projective dynamics on a prefactorised matrix: the stiff-cloth solver
-};
-
-// What an integrator's solve reads and reports, in one place for the panel, --json and the tests.
-// Reports its iterations and a relative residual (MassSpring::last_solver_iterations and _residual).
-constexpr bool reports_solve(Integrator i) {
-    return i == Integrator::ImplicitEuler || i == Integrator::Projective || i == Integrator::Xpbd;
-}
-// Reads integration.tolerance: implicit Euler's CG and projective's quasi-Newton iterations stop there.
-constexpr bool uses_tolerance(Integrator i) { return i == Integrator::ImplicitEuler || i == Integrator::Projective; }
-// Reads integration.iterations: projective's most iterations per substep (XPBD makes one pass, always).
-constexpr bool uses_iterations(Integrator i) { return i == Integrator::Projective; }
-
 // The outline of the cloth on its grid.
 enum class ClothShape {
     Rectangle,  // every particle of the rows x cols grid

@@ -785,7 +785,7 @@ void stats_section(const AppState& app) {
     const Integrator integrator = app.sim.settings().integration.integrator;
     ImGui::Text("integrator: %s%s", std::string(integrator_names()[static_cast<int>(integrator)]).c_str(),
                 reports_solve(integrator)
-                    ? ((integrator == Integrator::ImplicitEuler ? ", CG " : ", ") +
+                    ? (", " + std::string(integrator_info(integrator).solve_label) +
                        std::to_string(app.sim.last_solver_iterations()) + " iterations, residual " +
                        [&] {
                            char text[32];

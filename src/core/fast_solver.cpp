@@ -1,7 +1,7 @@
 #include "fast_solver.hpp"
 
 #include "clothsim/broad_phase.hpp"
-#include "verlet.hpp"
+#include "integrators/verlet.hpp"
 
 #include <immintrin.h>
 #include <omp.h>
@@ -18,7 +18,7 @@ namespace {
 
 // A stored spring row: a cache line of zero floats each side (so c - 2 and c + 1 are readable) and a stride of
 // whole lines, so that in the 64-byte-aligned buffers column 0 of every row starts a line and the row
-// update's vector loads at whole-vector columns do not split two lines (docs/PERFORMANCE.md: 8% of a substep).
+// update's vector loads at whole-vector columns do not split two lines (docs/PERFORMANCE.md).
 constexpr int kPad = 16;
 inline std::size_t spring_row_stride(int cols) {
     return (static_cast<std::size_t>(cols) + 2 * kPad + 15) & ~std::size_t{15};

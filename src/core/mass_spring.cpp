@@ -5,11 +5,12 @@
 #include "clothsim/tethers.hpp"
 #include "forces.hpp"
 #include "fast_solver.hpp"
-#include "grid_xpbd.hpp"
-#include "integrators.hpp"
+#include "integrators/grid_xpbd.hpp"
+#include "integrators/integrator_step.hpp"
+#include "integrators/integrators.hpp"
 #include "penalty_contact.hpp"
-#include "projective.hpp"
-#include "verlet.hpp"
+#include "integrators/projective.hpp"
+#include "integrators/verlet.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -77,13 +78,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     topology_stamp_ = next_stamp();
 }
 
-struct MassSpring::IterativeSolvers::Data {
-    ProjectiveSolver projective;
-    XpbdMultipliers xpbd;
-    std::optional<GridXpbd> grid_xpbd;  // XPBD's fast path, made from the topology when it is a grid
-    bool grid_xpbd_current = false;     // grid_xpbd matches the topology and the stiffness
-    bool grid_xpbd_ran = false;         // the last XPBD substep was the grid form's
-};
+struct MassSpring::IterativeSolvers::Data : IntegratorCaches {};
 MassSpring::IterativeSolvers::IterativeSolvers() : data(std::make_unique<Data>()) {}
 MassSpring::IterativeSolvers::IterativeSolvers(const IterativeSolvers& other)
     : data(std::make_unique<Data>(*other.data)) {}
@@ -205,7 +200,7 @@ void MassSpring::step() {
     // Moves outside the motions, which self-collision's budget does not count: a collider's push now, what
     // the stages after the last substep's self stage did, and the steps of RK4 and projective, whose motion
     // (v h at the substep's end) is not the substep's displacement.
-    const bool displaced = integrator == Integrator::Rk4 || integrator == Integrator::Projective;
+    const bool displaced = !integrator_info(integrator).motion_is_displacement;
     const bool self_moved =
         plan_.self_collision && collide_self(profile, known, collided || moved_uncounted_ || displaced);
     moved_uncounted_ = false;
@@ -298,10 +293,10 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
     }
 }
 
-// On the fast path the tethers run on the fast solver's threads, each on the row block it has just swept (its
-// particles are in that core's caches; a pass on one thread over the whole cloth made the second core's block
-// move to the first core and back every substep). Particles project independently (tethers.hpp), so the
-// result is the same on any number of threads.
+// On the fast path the tethers run on the fast solver's threads, each on the row block it has just swept, whose
+// particles are in that core's caches (one thread over the whole cloth would move the other core's block to
+// it and back every substep). Particles project independently (tethers.hpp), so the result is the same on any
+// number of threads.
 std::size_t MassSpring::apply_tethers() {
     const double strain = settings_.springs.tether_strain;
     if (plan_.path != StepPath::Fast || !fast_.solver) return project_tethers(state_, tethers_, strain);
@@ -509,7 +504,8 @@ bool MassSpring::limit_speed(double h) {
     return changed;
 }
 
-// One file per integrator, one switch (as solver2d does): all share compute_forces and the collision stage.
+// Every integrator but Verlet, through its row of the table (integrator.hpp): one call shape, one file each in
+// src/core/integrators/. All share compute_forces and the collision stage after them.
 void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool continues) {
     const ForceFunction forces = [this](const State& s, Vec3Array& f) { compute_forces(s, f); };
     const ForceFunction external = [this](const State& s, Vec3Array& f) {
@@ -521,54 +517,21 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
         if (grab_) f.add(grab_->particle, grab_force(s));
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
-    switch (integrator) {
-        case Integrator::SymplecticEuler: step_symplectic_euler(state_, dynamics, h); break;
-        case Integrator::Rk4: step_rk4(state_, dynamics, h); break;
-        case Integrator::ImplicitEuler:
-        {
-            const LinearSolve solve = step_implicit_euler(state_, dynamics, topology_, settings_.springs,
-                                                          settings_.integration.tolerance, h);
-            last_iterations_ = solve.iterations;
-            last_residual_ = solve.residual;
-        } break;
-        case Integrator::Xpbd: {
-            // The grid form on a grid cloth with solver.method = "fast", the list order otherwise.
-            IterativeSolvers::Data& data = *iterative_.data;
-            if (settings_.solver.method == SolverMethod::Fast && !data.grid_xpbd_current) {
-                data.grid_xpbd = GridXpbd::for_topology(topology_);
-                if (data.grid_xpbd) data.grid_xpbd->set_stiffness(topology_, settings_.springs);
-                data.grid_xpbd_current = true;
-            }
-            data.grid_xpbd_ran = settings_.solver.method == SolverMethod::Fast && data.grid_xpbd.has_value();
-            if (data.grid_xpbd_ran) {
-                data.grid_xpbd->step(state_, dynamics, h, settings_.solver.threads);
-            } else {
-                step_xpbd(state_, dynamics, topology_, settings_.springs, h, data.xpbd);
-            }
-            last_iterations_ = 1;
-        } break;
-        case Integrator::Projective: {
-            // Wind, contact and a grab are held at their value at the start of the substep; soft clips' holds
-            // are quadratic and in the solver's matrix (projective.hpp): held fixed over a BDF2 step they would
-            // feed it energy.
-            force_.resize(state_.size());
-            if (plan_.wind || plan_.contact) {
-                Vec3Array scratch;
-                add_external_forces(state_, force_, scratch, nullptr, false);
-            }
-            if (grab_) force_.add(grab_->particle, grab_force(state_));
-            ProjectiveSolver::Inputs inputs;
-            inputs.external = &force_;
-            inputs.gravity = settings_.forces.gravity;
-            inputs.damping = settings_.springs.damping;
-            inputs.iterations = settings_.integration.iterations;
-            inputs.tolerance = settings_.integration.tolerance;
-            const LinearSolve solve =
-                iterative_.data->projective.step(state_, topology_, settings_.springs, inputs, h, continues);
-            last_iterations_ = solve.iterations;
-            last_residual_ = solve.residual;
-        } break;
-        case Integrator::Verlet: break;  // handled by step()
+    IntegratorContext context{state_, topology_, settings_, dynamics, h, continues, *iterative_.data, {}, {}};
+    context.frozen_external = [this](Vec3Array& f) {
+        f.resize(state_.size());
+        if (plan_.wind || plan_.contact) {
+            Vec3Array scratch;
+            add_external_forces(state_, f, scratch, nullptr, false);
+        }
+        if (grab_) f.add(grab_->particle, grab_force(state_));
+    };
+    const IntegratorInfo& info = integrator_info(integrator);
+    if (!info.substep) return;  // Verlet: step() runs the fast solver or the textbook path
+    info.substep(context);
+    if (info.reports_solve) {
+        last_iterations_ = context.solve.iterations;
+        last_residual_ = context.solve.residual;
     }
 }
 
@@ -667,7 +630,7 @@ void MassSpring::restart(const std::vector<glm::dvec3>& velocity, double h) {
     history_stamp_ = 0;  // the velocities are new: a multistep integrator starts afresh
     const Integrator integrator = settings_.integration.integrator;
     state_.integrator = integrator;
-    if (integrator == Integrator::Verlet) {
+    if (!integrator_info(integrator).keeps_velocity) {  // Verlet: motion = x - x_prev
         compute_forces(state_, force_);
         start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
         return;
@@ -702,7 +665,7 @@ std::vector<glm::vec3> MassSpring::velocities() const {
 
 std::vector<glm::dvec3> MassSpring::velocities_in_double() const {
     if (asleep_) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
-    if (state_.integrator != Integrator::Verlet) {
+    if (integrator_info(state_.integrator).keeps_velocity) {
         std::vector<glm::dvec3> v(state_.size(), glm::dvec3(0.0));
         if (state_.substep > 0.0) {
             for (std::size_t i = 0; i < v.size(); ++i) v[i] = state_.motion.get(i) / state_.substep;

@@ -3,7 +3,7 @@
 #include "clothsim/colliders.hpp"
 #include "clothsim/scene.hpp"
 #include "forces.hpp"
-#include "integrators.hpp"
+#include "integrators/integrators.hpp"
 #include "penalty_contact.hpp"
 
 #include <glm/geometric.hpp>

@@ -88,8 +88,12 @@ constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corner
 constexpr std::array<std::string_view, 2> kClipHoldNames = {"rigid", "soft"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
-constexpr std::array<std::string_view, 6> kIntegratorNames = {"verlet", "symplectic-euler", "rk4", "implicit-euler",
-                                                               "xpbd", "projective"};
+// The integrators' names, from their table (integrator.hpp).
+constexpr std::array<std::string_view, kIntegrators.size()> kIntegratorNames = [] {
+    std::array<std::string_view, kIntegrators.size()> names{};
+    for (std::size_t i = 0; i < kIntegrators.size(); ++i) names[i] = kIntegrators[i].name;
+    return names;
+}();
 constexpr std::array<std::string_view, 2> kContactModelNames = {"projection", "penalty"};
 constexpr std::array<std::string_view, 2> kClothShapeNames = {"rectangle", "disc"};
 

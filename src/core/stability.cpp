@@ -69,22 +69,21 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
                                                 : std::numeric_limits<double>::infinity();
     const double explicit_substep = std::min(contact_substep, hold_substep);
     const StabilityBound explicit_bound = hold_substep < contact_substep ? StabilityBound::Clips : StabilityBound::Contact;
-    if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective) {
-        const bool projective = integrator == Integrator::Projective;
-        const double substep = projective ? contact_substep : explicit_substep;
-        limit.unconditionally_stable = !std::isfinite(substep);
+    // The integrator's row (integrator.hpp) says how its springs, damping and soft clips bound the substep.
+    const IntegratorInfo& info = integrator_info(integrator);
+    if (info.implicit_springs) {
+        // Springs implicit: contact (and soft clips, unless they are in the solver's matrix) are taken
+        // explicitly, and an explicit damping term is stable while c h < its limit.
+        double substep = info.holds_implicit ? contact_substep : explicit_substep;
+        StabilityBound bound = info.holds_implicit ? StabilityBound::Contact : explicit_bound;
+        if (info.damping_limit > 0.0) {
+            const double damping_substep = c > 0.0 ? info.damping_limit / c : std::numeric_limits<double>::infinity();
+            if (damping_substep <= substep) bound = StabilityBound::Damping;
+            substep = std::min(damping_substep, substep);
+        }
         limit.critical_substep = limit.plane_wave_substep = substep;
-        limit.bound = projective ? StabilityBound::Contact : explicit_bound;
-        limit.wind_substep = std::numeric_limits<double>::infinity();
-        return limit;
-    }
-    if (integrator == Integrator::Xpbd) {
-        // Springs are projected implicitly; the damping in XPBD's explicit prediction is forward Euler on a
-        // decay rate c, stable while c h < 2.
-        const double damping_substep = c > 0.0 ? 2.0 / c : std::numeric_limits<double>::infinity();
-        limit.critical_substep = limit.plane_wave_substep = std::min(damping_substep, explicit_substep);
-        limit.bound = damping_substep <= explicit_substep ? StabilityBound::Damping : explicit_bound;
-        limit.unconditionally_stable = !std::isfinite(limit.critical_substep);
+        limit.bound = bound;
+        limit.unconditionally_stable = !std::isfinite(substep);
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
@@ -113,8 +112,8 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double sum_k = double(std::max(k.structural.x, k.structural.y)) + double(k.shear) + bending;
     limit.omega_gershgorin = std::sqrt(gershgorin);
     limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest + hold_rate) : 0.0;
-    const double factor = integrator == Integrator::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
-    const DampingForm form = integrator == Integrator::SymplecticEuler ? DampingForm::Explicit : DampingForm::None;
+    const double factor = info.spring_factor;
+    const DampingForm form = info.explicit_damping ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);
     limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor, form);
     // Wind pressure on a particle's share of the area is a drag, F ~ drag A |w_rel| w_rel, whose rate
@@ -136,10 +135,10 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     }
     limit.critical_substep = std::min(limit.critical_substep, limit.wind_substep);
     limit.plane_wave_substep = std::min(limit.plane_wave_substep, limit.wind_substep);
-    if (integrator == Integrator::Rk4 && c > 0.0) {
-        // RK4 on a pure decay rate c is stable while c h < 2.785 (its stability region on the real axis).
-        limit.critical_substep = std::min(limit.critical_substep, 2.785 / c);
-        limit.plane_wave_substep = std::min(limit.plane_wave_substep, 2.785 / c);
+    if (info.damping_limit > 0.0 && c > 0.0) {
+        // Its damping alone (RK4 on a pure decay rate c: c h < 2.785, its stability region on the real axis).
+        limit.critical_substep = std::min(limit.critical_substep, info.damping_limit / c);
+        limit.plane_wave_substep = std::min(limit.plane_wave_substep, info.damping_limit / c);
     }
     return limit;
 }

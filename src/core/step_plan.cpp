@@ -50,7 +50,7 @@ bool wind_active(const ForceSettings& forces) {
 
 StepPlan plan_step(const Topology& topology, const SimulationSettings& settings, bool fast_solver, bool tethers) {
     StepPlan plan;
-    if (settings.integration.integrator != Integrator::Verlet) {
+    if (integrator_info(settings.integration.integrator).substep) {  // not Verlet: its own substep
         plan.path = StepPath::VelocityIntegrator;
     } else {
         plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::Fast

@@ -18,12 +18,10 @@ int Stepper::choose_substeps(MassSpring& sim) {
     if (policy_.auto_substeps) {
         const IntegrationSettings& integration = sim.settings().integration;
         int wanted = auto_substeps(limit(sim), integration.dt, policy_.safety);
-        // Implicit Euler, projective and XPBD are stable at large steps (their limit is contact's or damping's
-        // at most): their substeps are a choice of accuracy, which auto substeps raises to the limit but never
+        // An integrator with implicit springs is stable at large steps (its limit is contact's or damping's at
+        // most): its substeps are a choice of accuracy, which auto substeps raises to the limit but never
         // lowers (XPBD at 1 substep is stable and far softer than its springs).
-        const Integrator integrator = integration.integrator;
-        if (integrator == Integrator::ImplicitEuler || integrator == Integrator::Projective ||
-            integrator == Integrator::Xpbd) {
+        if (integrator_info(integration.integrator).implicit_springs) {
             wanted = std::max(wanted, integration.substeps);
         }
         sim.set_substeps(wanted);

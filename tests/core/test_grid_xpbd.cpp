@@ -2,7 +2,7 @@
 // the grid's order), across kernels; and the physics it must keep: momentum, pins, convergence to the spring
 // model as the substeps grow.
 #include "every_kernel.hpp"
-#include "grid_xpbd.hpp"
+#include "integrators/grid_xpbd.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 

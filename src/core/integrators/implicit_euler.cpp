@@ -1,4 +1,5 @@
 #include "integrators.hpp"
+#include "integrator_step.hpp"
 
 #include "forces.hpp"
 
@@ -123,6 +124,10 @@ LinearSolve step_implicit_euler(State& state, const Dynamics& dynamics, const To
         state.position.add(i, moved);
     }
     return {iterations, b_norm2 > 0.0 ? std::sqrt(r2 / b_norm2) : 0.0};
+}
+
+void implicit_euler_substep(IntegratorContext& c) {
+    c.solve = step_implicit_euler(c.state, c.dynamics, c.topology, c.settings.springs, c.settings.integration.tolerance, c.h);
 }
 
 }  // namespace clothsim

@@ -1,4 +1,5 @@
 #include "integrators.hpp"
+#include "integrator_step.hpp"
 
 namespace clothsim {
 
@@ -35,5 +36,7 @@ void step_symplectic_euler(State& state, const Dynamics& dynamics, double h) {
     }
     state.substep = h;
 }
+
+void symplectic_euler_substep(IntegratorContext& c) { step_symplectic_euler(c.state, c.dynamics, c.h); }
 
 }  // namespace clothsim

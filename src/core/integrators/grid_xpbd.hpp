@@ -15,8 +15,9 @@
 // row it travels one spring per pass instead of the whole row. A row's springs along it are computed whole
 // and the other pass's corrections dropped (a masked vector loop, twice or three times the arithmetic of
 // that direction, cheaper than a strided one).
-// Interleaving the directions row by row instead (all of row r's springs, then row r + 1's) was measured
-// and is not used: on `stiff-drape` at 16 substeps it stretched the cloth by 150% where it hit the sphere.
+// Interleaving the directions row by row instead (all of row r's springs, then row r + 1's) lets a
+// correction travel one row per pass: a cloth that hits a collider hard stretches far more (docs/
+// STIFF_CLOTH.md, "Rejected designs").
 // Gauss-Seidel in this order is the list-order projection in another order: step_xpbd on the same topology
 // with its springs and bends listed in this order gives the same positions bit for bit (the tests check it).
 // Every kernel (generic, AVX2, AVX-512, FastSolver's choice) gives the same positions too; only the sum of

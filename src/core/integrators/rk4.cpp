@@ -1,4 +1,5 @@
 #include "integrators.hpp"
+#include "integrator_step.hpp"
 
 namespace clothsim {
 
@@ -44,5 +45,7 @@ void step_rk4(State& state, const BasicDynamics<F>& dynamics, double h) {
 }
 template void step_rk4<float>(State&, const Dynamics&, double);
 template void step_rk4<double>(State&, const BasicDynamics<double>&, double);
+
+void rk4_substep(IntegratorContext& c) { step_rk4(c.state, c.dynamics, c.h); }
 
 }  // namespace clothsim

@@ -1,4 +1,5 @@
 #include "projective.hpp"
+#include "integrator_step.hpp"
 
 #include "forces.hpp"
 
@@ -364,6 +365,20 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
     }
     state.substep = h;
     return {iterations, first > 0.0 ? residual / first : 0.0};
+}
+
+// Wind, contact and a grab are held at their value at the start of the substep; soft clips' holds are
+// quadratic and in the solver's matrix (projective.hpp): held fixed over a BDF2 step they would feed it energy.
+void projective_substep(IntegratorContext& c) {
+    Vec3Array external;
+    c.frozen_external(external);
+    ProjectiveSolver::Inputs inputs;
+    inputs.external = &external;
+    inputs.gravity = c.settings.forces.gravity;
+    inputs.damping = c.settings.springs.damping;
+    inputs.iterations = c.settings.integration.iterations;
+    inputs.tolerance = c.settings.integration.tolerance;
+    c.solve = c.caches.projective.step(c.state, c.topology, c.settings.springs, inputs, c.h, c.continues);
 }
 
 }  // namespace clothsim

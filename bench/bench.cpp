@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
                 MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Textbook, 1));
                 bench::TextbookAos plain(sim);
                 aos = median_seconds([&] { plain.step(); }, repeats, min_seconds);
-                textbook = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+                textbook = median_seconds([&] { sim.substep(); }, repeats, min_seconds);
                 require_finite(sim, scene, size);
                 rows.push_back({size, sim.particle_count(), sim.spring_count(), "textbook-aos", 1, aos,
                                 textbook / aos, 1.0});
@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
             }
             for (int t : thread_counts) {
                 MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Fast, t));
-                const double fast = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+                const double fast = median_seconds([&] { sim.substep(); }, repeats, min_seconds);
                 require_finite(sim, scene, size);
                 rows.push_back({size, sim.particle_count(), sim.spring_count(), "fast", sim.solver_threads(), fast,
                                 textbook / fast, aos / fast});
@@ -246,7 +246,7 @@ int main(int argc, char** argv) {
     std::vector<Budget> budgets;
     for (int size : {128, 256}) {
         MassSpring sim = build_simulation(grid_scene(scene, size, SolverMethod::Fast, 0));
-        const double substep = median_seconds([&] { sim.step(); }, repeats, min_seconds);
+        const double substep = median_seconds([&] { sim.substep(); }, repeats, min_seconds);
         std::vector<glm::vec3> normals, positions;
         const double prep = median_seconds(
             [&] {

@@ -7,7 +7,7 @@
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
-#include "forces.hpp"
+#include "model/forces.hpp"
 #include "integrators/verlet.hpp"
 
 #include "per_spring_scenes.hpp"
@@ -53,13 +53,13 @@ void BM_TextbookSpringForces(benchmark::State& state) {
 
 void BM_FastSubstep(benchmark::State& state) {
     MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Fast, static_cast<int>(state.range(1)));
-    for (auto _ : state) sim.step();
+    for (auto _ : state) sim.substep();
     set_counters(state, sim);
 }
 
 void BM_TextbookSubstep(benchmark::State& state) {
     MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
-    for (auto _ : state) sim.step();
+    for (auto _ : state) sim.substep();
     set_counters(state, sim);
 }
 

@@ -179,7 +179,7 @@ int run_skipping(const SkippingOptions& o) {
                 p.a = "no bending springs";
                 p.b = "bending stiffness 0";
                 p.size = size;
-                p.note = a.plan().path == StepPath::Fast && b.plan().path == StepPath::Fast ? "both on the fast solver" : "not both on the fast solver";
+                p.note = a.plan().path == StepPath::FastVerlet && b.plan().path == StepPath::FastVerlet ? "both on the fast solver" : "not both on the fast solver";
                 pairs.push_back(p);
             }
             // 3. A sleeping cloth against an awake one, per app frame (guarded step and normals).

@@ -53,7 +53,7 @@ bool stable(const Case& c, double h, double duration) {
     const double e0 = sim.energy().total();
     const long long steps = std::max(200LL, std::llround(duration / h));
     for (long long i = 0; i < steps; ++i) {
-        sim.step();
+        sim.substep();
         if ((i & 63) == 63 && !sim.all_finite()) return false;
     }
     if (!sim.all_finite()) return false;

@@ -22,7 +22,7 @@
 //   nice build/release/bench/clothsim-state-study
 #include "clothsim/reference.hpp"
 #include "clothsim/scene.hpp"
-#include "forces.hpp"
+#include "model/forces.hpp"
 #include "integrators/verlet.hpp"
 
 #include "per_spring_scenes.hpp"

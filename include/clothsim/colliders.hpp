@@ -59,6 +59,11 @@ struct CollisionBlocks {
     glm::dvec3 carried_lo{0.0}, carried_hi{0.0};  // the carried box (above), in double: it grows every substep
     bool carried_valid = false;
     Box carried() const { return Box{glm::vec3(carried_lo), glm::vec3(carried_hi)}; }
+    // The particles are about to move (a substep begins): the last substep's boxes no longer bound them.
+    void positions_moving() { current = boxes_current = false; }
+    // A move the carried box does not follow (an edit, a dragged pin, a push, a limit): it is made again from
+    // the next whole boxes.
+    void moved_outside_motion() { carried_valid = false; }
     // Grows the carried box by `by` on every side; drops it when `by` is not a number that bounds anything.
     void widen_carried(double by) {
         carried_valid = carried_valid && std::isfinite(by);

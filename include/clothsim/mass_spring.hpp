@@ -1,7 +1,7 @@
 // MassSpring: a cloth of particles joined by Hooke springs, advanced by one of six integrators (position
 // Verlet, the default; symplectic Euler, RK4, implicit Euler, XPBD, projective: the table in integrator.hpp).
 //
-// The pipeline of one substep is MassSpring::step() in src/core/mass_spring.cpp; read it top to bottom:
+// The pipeline of one substep is MassSpring::substep() in src/core/simulation/mass_spring.cpp; read it top to bottom:
 // accumulate forces (springs, wind, penalty contact, the user's grab), integrate (gravity and damping inside),
 // collide (the projection contact with the scene's list of shapes: collider.hpp), pull tethered particles back to their pins, limit strain and speed, and once per step see whether
 // the cloth may sleep. colliders.contact picks penalty contact (a force) or projection (a stage after). Which of these stages
@@ -20,7 +20,9 @@
 // it, and it restarts from rest.
 #pragma once
 
+#include "clothsim/grab_spring.hpp"
 #include "clothsim/particle.hpp"
+#include "clothsim/sleep_monitor.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 #include "clothsim/step_plan.hpp"
@@ -66,8 +68,8 @@ public:
     MassSpring(MassSpring&&) noexcept;
     MassSpring& operator=(MassSpring&&) noexcept;
 
-    // One integration substep of length substep_length().
-    void step();
+    // One integration substep of length substep_length(): the whole pipeline, stage by stage.
+    void substep();
     // `steps` whole steps of settings().integration.dt, each made of `substeps` substeps.
     void run_steps(long long steps);
 
@@ -142,11 +144,10 @@ public:
     void reset_profile() { profile_ = StepProfile{}; }
     void set_profiling(bool on) { profiling_ = on; }
 
-    bool asleep() const { return asleep_; }
-    // s: how long the cloth has stayed under sleep_speed (it sleeps at solver.sleep_time).
-    double calm_seconds() const { return calm_seconds_; }
     // Asleep: the next step will not move anything (every change that could move the cloth wakes it).
-    bool resting() const { return asleep_; }
+    bool asleep() const { return sleep_.asleep(); }
+    // s: how long the cloth has stayed under sleep_speed (it sleeps at solver.sleep_time).
+    double calm_seconds() const { return sleep_.calm_seconds(); }
     // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
     void wake();
     // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
@@ -214,7 +215,7 @@ private:
     void add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch, StepProfile* profile,
                              bool holds = true) const;
     void replan();
-    // The stages of step(), in pipeline order.
+    // The stages of substep(), in pipeline order.
     void step_fast(double h, StepProfile* profile);
     void step_textbook(double h, StepProfile* profile);
     // `continues`: the state is what the previous substep left (a multistep integrator may use its history).
@@ -240,7 +241,6 @@ private:
     void topology_changed(std::size_t removed);
     void rebuild_tethers();
     void build_fast_solver();
-    void check_sleep(double h);
     glm::vec3 grab_force(const State& state) const;
     // N: the grab's force cap for particle i at the current masses and stiffness (grab()).
     float grab_force_limit(std::size_t i) const;
@@ -304,19 +304,11 @@ private:
     std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
     double last_residual_ = 0.0;
-    bool asleep_ = false;
-    double calm_seconds_ = 0.0;  // s: how long the cloth has been slower than sleep_speed
-    DVec3Array sleep_reference_;  // m: positions at the last sleep check (empty: none since waking)
-    double sleep_reference_time_ = 0.0;
+    SleepMonitor sleep_;
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;
     std::uint64_t setup_stamp_ = 0;
-    struct Grab {
-        std::size_t particle = 0;
-        glm::vec3 target{0.0f};
-        float force_limit = 0.0f;  // N
-    };
-    std::optional<Grab> grab_;
+    std::optional<GrabSpring> grab_;
     struct PinTarget {
         std::size_t particle = 0;
         glm::dvec3 target{0.0};  // m

@@ -59,7 +59,7 @@ std::string format_value(const Scene& scene, const FieldInfo& field);
 void copy_field(const FieldInfo& field, const Scene& from, Scene& to);
 
 // ---- The colliders' fields: [[colliders.shapes]] entries, each `kind` plus that kind's rows. ----
-// One row of one collider: `enabled` and `friction` (every kind), then its kind's rows (shapes/*.hpp kFields).
+// One row of one collider: `enabled` and `friction` (every kind), then its kind's rows (shapes/*.hpp fields()).
 struct ColliderField {
     std::string_view name;  // within the entry: "radius"
     std::string_view unit;

@@ -1,7 +1,7 @@
 // Settings of a scene, with their defaults.
 //
 // These plain structs are what a scene file loads into, what `--set` overrides and what the panel edits.
-// Each field's unit, valid range and one-line meaning are listed once, in src/core/scene_fields.cpp
+// Each field's unit, valid range and one-line meaning are listed once, in src/core/scene/scene_fields.cpp
 // (the field table); the comments here only repeat the unit.
 #pragma once
 
@@ -34,9 +34,9 @@ enum class ClothShape {
                 // specimen; the others are absent (state.hpp), with no springs, mass or triangles
 };
 
-// Which implementation advances the cloth. Both integrate the same model; see src/core/fast_solver.hpp.
+// Which implementation advances the cloth. Both integrate the same model; see src/core/integrators/fast_solver.hpp.
 enum class SolverMethod {
-    Fast,      // row sweeps over the grid: vectorised, multi-threaded, each spring once, stages fused
+    Fast,      // row sweeps over the grid (Verlet's fast solver, XPBD's grid form): vectorised, threaded, stages fused
     Textbook,  // one loop over the spring list, one over the particles: the oracle the tests compare with
 };
 

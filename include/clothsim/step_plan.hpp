@@ -6,7 +6,7 @@
 // no strain or speed limit. The contact model picks the colliders' stage: projection runs the colliders
 // stage (every enabled shape in the list) after integration; penalty contact does not run it and adds a force
 // stage ("contact") beside the wind instead. The fast solver compiles one variant per set of spring kinds, so a skipped kind
-// costs no instruction in the hot loop (src/core/fast_solver.cpp). Gravity and damping are coefficients of
+// costs no instruction in the hot loop (src/core/integrators/fast_solver.cpp). Gravity and damping are coefficients of
 // the Verlet update's single multiply-add, not stages of their own: they cost the same whatever their value.
 #pragma once
 
@@ -22,13 +22,13 @@ namespace clothsim {
 
 // How a substep advances the cloth.
 enum class StepPath {
-    Fast,               // Verlet in the fast solver: springs and integration fused row by row
-    Textbook,           // Verlet over the spring list, then over the particles
-    VelocityIntegrator, // symplectic Euler, RK4, implicit Euler or XPBD
+    FastVerlet,         // Verlet in the fast solver: springs and integration fused row by row
+    TextbookVerlet,     // Verlet over the spring list, then over the particles (the oracle)
+    VelocityIntegrator, // another integrator, through its row of the table (integrator.hpp)
 };
 
 struct StepPlan {
-    StepPath path = StepPath::Textbook;
+    StepPath path = StepPath::TextbookVerlet;
     std::array<bool, kSpringKindCount> springs{};  // a kind runs: it has springs and a non-zero stiffness
     bool wind = false;
     bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)

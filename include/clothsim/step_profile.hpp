@@ -1,6 +1,6 @@
 // StepProfile: where the time of a step goes, stage by stage (like Box2D's b2Profile).
 //
-// MassSpring::step() times each stage it runs with the steady clock and adds it here; a stage the plan
+// MassSpring::substep() times each stage it runs with the steady clock and adds it here; a stage the plan
 // skips (step_plan.hpp) is not timed at all and shows 0 with the plan's reason. The app reads the profile
 // every frame and resets it; `clothsim --headless --json` reports the totals of the run.
 #pragma once

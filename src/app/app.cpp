@@ -150,7 +150,7 @@ void record_plots(AppState& app, bool rested) {
 bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
     const auto start = Clock::now();
     app.sim.reset_profile();
-    const bool was_resting = app.sim.resting();
+    const bool was_resting = app.sim.asleep();
     StepReport report;
     if (app.step_once) {
         report = app.stepper.run(app.sim, 1);
@@ -167,7 +167,7 @@ bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
         app.say("the cloth is no longer finite (NaN or infinite positions) and is not stepped; R restarts the scene",
                 true);
     }
-    if (report.steps > 0) record_plots(app, was_resting && app.sim.resting());
+    if (report.steps > 0) record_plots(app, was_resting && app.sim.asleep());
     if (!app.paused && !one_step_a_frame) {  // playing in real time: is it keeping up?
         app.stats.window_wall += wall_seconds;
         app.stats.window_simulated += double(report.steps) * app.sim.settings().integration.dt;

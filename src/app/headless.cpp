@@ -274,7 +274,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     const Integrator integrator = sim.settings().integration.integrator;
     nlohmann::json solver = {
         {"integrator", integrator_names()[static_cast<int>(integrator)]},
-        {"path", sim.last_step_fast() ? "fast" : sim.plan().path == StepPath::Textbook ? "textbook" : "velocity integrator"},
+        {"path", sim.last_step_fast() ? "fast" : sim.plan().path == StepPath::TextbookVerlet ? "textbook" : "velocity integrator"},
         {"threads", sim.solver_threads()},
     };
     if (reports_solve(integrator)) {

@@ -120,7 +120,7 @@ TEST_CASE("cloth shape: a disc runs on the fast solver bit for bit with the text
             if (start.state().pinned[i] == kAbsent) CHECK(textbook.state().position.get(i) == start.state().position.get(i));
         }
         test::with_every_kernel([&] {
-            for (int threads : {1, 2}) {
+            for (int threads : test::thread_counts({1, 2})) {
                 INFO((material ? "material" : "per spring") << ", kernel " << FastSolver::kernel_name() << ", "
                                                             << threads << " threads");
                 CHECK(test::bit_identical(run(SolverMethod::Fast, threads), textbook));

@@ -1,7 +1,7 @@
-// Penalty contact (colliders.contact = penalty; src/core/penalty_contact.hpp): the force law against the
+// Penalty contact (colliders.contact = penalty; src/core/collision/penalty_contact.hpp): the force law against the
 // analytic rest depth, energy conservation through a bounce, the fast and textbook paths bit for bit, and
 // the stability bound that counts the contact stiffness.
-#include "penalty_contact.hpp"
+#include "collision/penalty_contact.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
@@ -168,7 +168,7 @@ TEST_CASE("penalty contact: an undamped bounce conserves total energy, to RK4's 
         double worst = 0.0, deepest = 0.0, contact_energy = 0.0, highest_after = -1.0;
         for (int step = 0; step < 9; ++step) {  // 0.15 s: down, through the contact, back up to the top
             for (int i = 0; i < substeps; ++i) {
-                sim.step();
+                sim.substep();
                 const Energy e = sim.energy();
                 worst = std::max(worst, std::fabs(e.total() - e0));
                 deepest = std::max(deepest, depth(sim));
@@ -214,7 +214,7 @@ TEST_CASE("penalty contact: an undamped bounce on the cylinder conserves total e
             double worst = 0.0, deepest = 0.0, contact_energy = 0.0;
             for (int step = 0; step < 9; ++step) {  // 0.15 s: down, through the contact, back out
                 for (int i = 0; i < substeps; ++i) {
-                    sim.step();
+                    sim.substep();
                     const Energy e = sim.energy();
                     worst = std::max(worst, std::fabs(e.total() - e0));
                     deepest = std::max(deepest, cylinder_depth(sim));
@@ -263,8 +263,8 @@ TEST_CASE("penalty contact: fast and textbook solvers give bit-identical drapes"
     };
     const MassSpring fast = run(SolverMethod::Fast);
     const MassSpring textbook = run(SolverMethod::Textbook);
-    CHECK(fast.plan().path == StepPath::Fast);
-    CHECK(textbook.plan().path == StepPath::Textbook);
+    CHECK(fast.plan().path == StepPath::FastVerlet);
+    CHECK(textbook.plan().path == StepPath::TextbookVerlet);
     CHECK(fast.energy().contact_potential > 0.0);  // the cloth is on the sphere
     CHECK(fast.all_finite());
     CHECK(test::bit_identical(fast, textbook));

@@ -1,7 +1,7 @@
 // The fast solver against the textbook solver (the oracle), determinism across thread counts, and
 // the fallbacks (generic kernel, non-grid topologies).
 #include "every_kernel.hpp"
-#include "fast_solver.hpp"
+#include "integrators/fast_solver.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
@@ -33,7 +33,7 @@ MassSpring run(Scene scene, SolverMethod method, int threads, long long substeps
     scene.settings.solver.threads = threads;
     MassSpring sim = build_simulation(scene);
     REQUIRE(sim.fast_solver_available());
-    for (long long i = 0; i < substeps; ++i) sim.step();
+    for (long long i = 0; i < substeps; ++i) sim.substep();
     return sim;
 }
 
@@ -135,7 +135,7 @@ TEST_CASE("fast solver agrees with the textbook solver bit for bit on a cloth dr
     for (int threads : {1, 2, 3}) {
         INFO(threads << " threads");
         const MassSpring fast = run(scene, SolverMethod::Fast, threads, 1000);
-        CHECK(fast.plan().path == StepPath::Fast);
+        CHECK(fast.plan().path == StepPath::FastVerlet);
         CHECK(fast.profile().runs_of(Stage::Colliders) == 1000);
         CHECK(fast.profile().blocks_offered[2] > 0);  // the cylinder (kind 2) was tested
         CHECK(fast.all_finite());
@@ -218,7 +218,7 @@ TEST_CASE("fast solver steps every row block when OpenMP gives fewer threads tha
 #pragma omp parallel num_threads(2)
     {
 #pragma omp single
-        for (int i = 0; i < 100; ++i) nested.step();
+        for (int i = 0; i < 100; ++i) nested.substep();
     }
     CHECK(nested.solver_threads() == 4);
     CHECK(test::bit_identical(one, nested));
@@ -231,8 +231,8 @@ TEST_CASE("fast solver: automatic threads switch between the team and one thread
     s.settings.solver.threads = 1;
     MassSpring one = build_simulation(s);
     for (int i = 0; i < 600; ++i) {  // several probes of the other choice (every 64 substeps at first)
-        automatic.step();
-        one.step();
+        automatic.substep();
+        one.substep();
     }
     CHECK(automatic.positions() == one.positions());
 }
@@ -321,31 +321,31 @@ TEST_CASE("fast solver sees particles moved between its substeps by collisions, 
         auto set_integrator = [&](Integrator i) {
             test::edit_settings(sim, [&](SimulationSettings& t) { t.integration.integrator = i; });
         };
-        for (int i = 0; i < 5; ++i) sim.step();
+        for (int i = 0; i < 5; ++i) sim.substep();
         sim.set_particle(100, sim.position(100) + glm::vec3(0.0f, 0.01f, 0.0f), {0.0f, 0.1f, 0.0f});
-        sim.step();
+        sim.substep();
         sim.move_pinned(0, sim.position(0) + glm::vec3(0.01f, 0.0f, 0.0f));
-        sim.step();
+        sim.substep();
         set_integrator(Integrator::Rk4);
-        sim.step();
+        sim.substep();
         set_integrator(Integrator::Verlet);
-        sim.step();
+        sim.substep();
         set_method(SolverMethod::Textbook);
-        sim.step();
+        sim.substep();
         set_method(method);
-        sim.step();
+        sim.substep();
         // Limits correct positions after the substep (the cloth falls faster than 1 cm/s by now).
         test::edit_settings(sim, [](SimulationSettings& t) {
             t.springs.strain_limit = 0.02f;
             t.forces.max_speed = 0.01f;
         });
-        sim.step();
+        sim.substep();
         test::edit_settings(sim, [](SimulationSettings& t) {
             t.springs.strain_limit = 0.0f;
             t.forces.max_speed = 0.0f;
         });
-        sim.step();
-        for (int i = 0; i < 1500; ++i) sim.step();  // onto the sphere: collisions move particles
+        sim.substep();
+        for (int i = 0; i < 1500; ++i) sim.substep();  // onto the sphere: collisions move particles
         CHECK(test::collider(sim.settings().colliders, "sphere").enabled);
         double nearest = INFINITY;  // to the sphere's centre
         for (std::size_t i = 0; i < sim.particle_count(); ++i) {

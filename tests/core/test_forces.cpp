@@ -1,5 +1,5 @@
 // Force stages: Hooke's law, wind pressure on triangles (edge-on: none), gusts.
-#include "forces.hpp"
+#include "model/forces.hpp"
 #include "support.hpp"
 
 #include <catch2/catch.hpp>

@@ -34,7 +34,7 @@ double oscillator_error(Integrator integrator, int substeps_per_period, double c
     double worst = 0.0;
     const long long steps = std::llround(2.0 * period / h);
     for (long long i = 0; i < steps; ++i) {
-        sim.step();
+        sim.substep();
         const double t = sim.time();
         const double exact = amplitude * std::exp(-gamma * t) * (std::cos(wd * t) + gamma / wd * std::sin(wd * t));
         worst = std::max(worst, std::fabs(-(double(sim.position(1).y) + rest) - exact));

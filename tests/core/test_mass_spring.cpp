@@ -131,7 +131,7 @@ TEST_CASE("mass_spring positions into a kept array equal positions(), whatever t
     // An array of the right size is written in place, not reallocated (the renderer's frame).
     std::vector<glm::vec3> frame(fresh.size());
     const glm::vec3* memory = frame.data();
-    sim.step();
+    sim.substep();
     sim.positions(frame);
     CHECK(frame.data() == memory);
     CHECK(frame == sim.positions());
@@ -189,7 +189,7 @@ TEST_CASE("drag_pin: the pin travels to its target over one step, at most a quar
     REQUIRE(sim.pin_target(pin).has_value());
     glm::dvec3 last = start;
     for (int k = 0; k < substeps; ++k) {
-        sim.step();
+        sim.substep();
         const glm::dvec3 x = sim.state().position.get(pin);
         CHECK(glm::length(x - last) == Approx(glm::length(glm::dvec3(near) - start) / substeps).epsilon(1e-3));
         last = x;
@@ -203,7 +203,7 @@ TEST_CASE("drag_pin: the pin travels to its target over one step, at most a quar
     int taken = 0;
     for (; taken < 1000 && sim.pin_target(pin); ++taken) {
         const glm::dvec3 before = sim.state().position.get(pin);
-        sim.step();
+        sim.substep();
         longest = std::max(longest, glm::length(sim.state().position.get(pin) - before));
     }
     CHECK(longest == Approx(MassSpring::kPinStepPerSubstep * spacing).epsilon(1e-6));

@@ -181,7 +181,7 @@ TEST_CASE("self-collision: two approaching strangers are pushed to the distance,
     sim.set_particle(12, sim.position(0) + glm::vec3(0.9f * static_cast<float>(d), 0.0f, 0.0f), glm::vec3(-0.5f, 0.0f, 0.0f));
     sim.set_particle(0, sim.position(0), glm::vec3(0.5f, 0.0f, 0.0f));
     const glm::vec3 before = sim.momentum();
-    sim.step();
+    sim.substep();
     const double gap = glm::length(sim.state().position.get(12) - sim.state().position.get(0));
     CHECK(gap == Approx(d).epsilon(1e-6));
     const glm::dvec3 approach = sim.state().motion.get(12) - sim.state().motion.get(0);
@@ -216,7 +216,7 @@ TEST_CASE("self-collision: between tests the stage resolves every touching pair 
         };
         for (long long k = 0; k < substeps; ++k) {
             const long long blocks = tested_blocks();
-            sim.step();
+            sim.substep();
             // As MassSpring tells its own stage: a collider that tested particles may have pushed them outside
             // their motion; substeps without may be skipped beyond kSelfSkipMax.
             const bool uncounted = tested_blocks() > blocks;
@@ -341,6 +341,6 @@ TEST_CASE("self-collision: turned off and on again, it tests at its first subste
     on.collision.self = true;
     sim.apply(on);
     const long long tiles = sim.profile().self_tiles;
-    sim.step();
+    sim.substep();
     CHECK(sim.profile().self_tiles > tiles);
 }

@@ -85,7 +85,7 @@ MassSpring asleep_cloth() {
     MassSpring sim = build_simulation(settling_scene());
     settle(sim);
     REQUIRE(sim.asleep());
-    REQUIRE(sim.resting());
+    REQUIRE(sim.asleep());
     return sim;
 }
 
@@ -102,7 +102,7 @@ TEST_CASE("sleep a settling cloth falls asleep and then stays exactly where it i
         const int steps = settle(sim);
         INFO("asleep after " << steps << " steps");
         CHECK(steps > 30);  // not before sleep_time has passed at all
-        CHECK(sim.resting());
+        CHECK(sim.asleep());
         CHECK(sim.energy().kinetic == 0.0);
         for (const glm::vec3& v : sim.velocities()) CHECK(v == glm::vec3(0.0f));
 
@@ -283,7 +283,7 @@ TEST_CASE("sleep wind wakes a sleeping cloth and keeps it awake while it blows",
     const std::vector<glm::vec3> held = sim.positions();
     // Across the hanging cloth (it hangs in the x-y plane); the change wakes it at once.
     test::edit_settings(sim, [](SimulationSettings& edit) { edit.forces.wind = {0.0f, 0.0f, 3.0f}; });
-    CHECK_FALSE(sim.resting());
+    CHECK_FALSE(sim.asleep());
     sim.run_steps(1);
     CHECK_FALSE(sim.asleep());
     CHECK_FALSE(sim.plan().may_sleep);
@@ -356,14 +356,14 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
 TEST_CASE("sleep any settings change wakes a sleeping cloth and no change keeps it asleep", "[sleep]") {
     MassSpring sim = asleep_cloth();
     sim.apply(sim.settings());  // the same values: no change
-    CHECK(sim.resting());
+    CHECK(sim.asleep());
     sim.run_steps(3);
     CHECK(sim.asleep());
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.bending *= 2.0f; });
-    CHECK_FALSE(sim.resting());
+    CHECK_FALSE(sim.asleep());
     CHECK_FALSE(sim.asleep());  // woken at the point of change
-    sim.step();
+    sim.substep();
     CHECK_FALSE(sim.asleep());
 
     MassSpring heavier = asleep_cloth();
@@ -375,7 +375,7 @@ TEST_CASE("sleep any settings change wakes a sleeping cloth and no change keeps 
 
     MassSpring damped = asleep_cloth();
     test::edit_settings(damped, [&](SimulationSettings& edit) { edit.springs.damping = 5.0f; });
-    damped.step();
+    damped.substep();
     CHECK_FALSE(damped.asleep());
 }
 
@@ -384,8 +384,8 @@ TEST_CASE("sleep a woken cloth restarts from rest exactly as a fresh cloth at th
     test::edit_settings(sim, [](SimulationSettings& edit) { edit.forces.gravity.y = -5.0f; });  // the change that wakes it
     // A fresh simulation of the same cloth, at the same positions, started at rest with the new settings.
     MassSpring fresh(sim.topology(), sim.state(), sim.settings());
-    sim.step();  // wakes, restarts from rest and integrates one substep
-    fresh.step();
+    sim.substep();  // wakes, restarts from rest and integrates one substep
+    fresh.substep();
     REQUIRE_FALSE(sim.asleep());
     require_same_positions(sim, fresh);
     const std::vector<glm::vec3> v = sim.velocities(), w = fresh.velocities();
@@ -417,7 +417,7 @@ TEST_CASE("sleep a copy of a sleeping cloth is asleep and steps identically", "[
     MassSpring sim = asleep_cloth();
     MassSpring copy = sim;
     CHECK(copy.asleep());
-    CHECK(copy.resting());
+    CHECK(copy.asleep());
     CHECK(copy.change_stamp() == sim.change_stamp());
     sim.run_steps(10);
     copy.run_steps(10);

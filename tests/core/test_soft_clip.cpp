@@ -189,8 +189,8 @@ TEST_CASE("soft clip: the fast solver agrees with the textbook solver bit for bi
             MassSpring fast = build_simulation(s);
             s.settings.solver.method = SolverMethod::Textbook;
             MassSpring textbook = build_simulation(s);
-            REQUIRE(fast.plan().path == StepPath::Fast);
-            REQUIRE(textbook.plan().path == StepPath::Textbook);
+            REQUIRE(fast.plan().path == StepPath::FastVerlet);
+            REQUIRE(textbook.plan().path == StepPath::TextbookVerlet);
             fast.run_steps(10);
             textbook.run_steps(10);
             INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");

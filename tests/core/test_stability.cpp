@@ -252,7 +252,7 @@ double oscillator_amplitude(Integrator integrator, double c, double h, int subst
     // swing through the pin, where a single sample can be anywhere).
     double amplitude = 0.0;
     for (int i = 0; i < substeps; ++i) {
-        sim.step();
+        sim.substep();
         if (i >= substeps - 100) amplitude = std::max(amplitude, std::fabs(sim.state().position.y[1] + 0.5));
     }
     if (!sim.all_finite()) return std::numeric_limits<double>::infinity();

@@ -57,7 +57,7 @@ Scene drape_scene(const std::string& name) {
 }
 
 void step_n(MassSpring& sim, int substeps) {
-    for (int i = 0; i < substeps; ++i) sim.step();
+    for (int i = 0; i < substeps; ++i) sim.substep();
 }
 
 // The hanging cloth, small, with sleeping off so that only the stage under test differs between runs. In the
@@ -122,8 +122,8 @@ TEST_CASE("step_plan a spring kind with stiffness 0 moves the cloth bit for bit 
             if (method == SolverMethod::Fast) {
                 // A topology missing a whole spring kind is still a grid: the fast solver must run it.
                 CHECK(without_kind.fast_solver_available());
-                CHECK(without_kind.plan().path == StepPath::Fast);
-                CHECK(with_kind.plan().path == StepPath::Fast);
+                CHECK(without_kind.plan().path == StepPath::FastVerlet);
+                CHECK(with_kind.plan().path == StepPath::FastVerlet);
             }
             const std::vector<glm::vec3> start = with_kind.positions();
             step_n(with_kind, 60);
@@ -151,12 +151,12 @@ TEST_CASE("step_plan fast and textbook solvers agree bit for bit for every set o
                         if (!((mask >> static_cast<int>(kind)) & 1u)) switch_off(s.springs, kind);
                     }
                 });
-                sim.step();  // the plan follows the settings from this step on
+                sim.substep();  // the plan follows the settings from this step on
                 CHECK(sim.plan().spring_mask() == mask);
                 step_n(sim, 39);
             }
-            CHECK(runs[0].plan().path == StepPath::Fast);
-            CHECK(runs[1].plan().path == StepPath::Textbook);
+            CHECK(runs[0].plan().path == StepPath::FastVerlet);
+            CHECK(runs[1].plan().path == StepPath::TextbookVerlet);
             require_same_positions(runs[0], runs[1]);
         }
     }
@@ -298,7 +298,7 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     test::collider(s.colliders, "ground").enabled = false;
 
     StepPlan p = plan_step(t, s, true);
-    CHECK(p.path == StepPath::Fast);
+    CHECK(p.path == StepPath::FastVerlet);
     CHECK(p.spring_mask() == 7u);
     CHECK_FALSE(p.wind);
     CHECK_FALSE(p.colliders);
@@ -307,9 +307,9 @@ TEST_CASE("step_plan plan_step follows each setting", "[step_plan]") {
     CHECK_FALSE(p.speed_limit);
     CHECK_FALSE(p.may_sleep);  // small_hanging turns sleeping off
 
-    CHECK(plan_step(t, s, false).path == StepPath::Textbook);  // no fast solver for this topology
+    CHECK(plan_step(t, s, false).path == StepPath::TextbookVerlet);  // no fast solver for this topology
     s.solver.method = SolverMethod::Textbook;
-    CHECK(plan_step(t, s, true).path == StepPath::Textbook);
+    CHECK(plan_step(t, s, true).path == StepPath::TextbookVerlet);
     s.solver.method = SolverMethod::Fast;
     for (Integrator i : {Integrator::SymplecticEuler, Integrator::Rk4, Integrator::ImplicitEuler, Integrator::Xpbd}) {
         s.integration.integrator = i;
@@ -370,14 +370,14 @@ TEST_CASE("step_plan a setting applied to a live simulation replans at the point
     REQUIRE(sim.plan().springs[2]);
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.bending = glm::vec2(0.0f); });
     CHECK_FALSE(sim.plan().springs[2]);  // at once, not at the next step
-    sim.step();
+    sim.substep();
     CHECK_FALSE(sim.plan().springs[2]);
-    CHECK(sim.plan().path == StepPath::Fast);
+    CHECK(sim.plan().path == StepPath::FastVerlet);
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.springs.strain_limit = 0.1f; });
     test::edit_settings(sim, [&](SimulationSettings& edit) { test::collider(edit.colliders, "sphere").enabled = true; });
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = Integrator::Rk4; });
-    sim.step();
+    sim.substep();
     CHECK(sim.plan().strain_limit);
     CHECK(sim.plan().solids);
     CHECK(projected_kinds(sim.plan(), sim.topology(), sim.settings()).find("sphere") != std::string::npos);
@@ -385,8 +385,8 @@ TEST_CASE("step_plan a setting applied to a live simulation replans at the point
 
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.integration.integrator = Integrator::Verlet; });
     test::edit_settings(sim, [&](SimulationSettings& edit) { edit.solver.method = SolverMethod::Textbook; });
-    sim.step();
-    CHECK(sim.plan().path == StepPath::Textbook);
+    sim.substep();
+    CHECK(sim.plan().path == StepPath::TextbookVerlet);
 }
 
 TEST_CASE("step_plan describe lists every stage once and names the setting that skips one", "[step_plan]") {

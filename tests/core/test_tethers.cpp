@@ -120,13 +120,13 @@ TEST_CASE("tethers: on the fast solver's row blocks and threads the cloth is the
         test::plane(s.settings.colliders).height = 1.0f;  // the hem (0.6 m when hanging straight) lies on it
         s.settings.solver.method = SolverMethod::Textbook;
         MassSpring textbook = build_simulation(s);
-        REQUIRE(textbook.plan().path == StepPath::Textbook);
+        REQUIRE(textbook.plan().path == StepPath::TextbookVerlet);
         textbook.run_steps(60);
-        for (int threads : {1, 2, 3}) {
+        for (int threads : test::thread_counts({1, 2, 3})) {
             s.settings.solver.threads = threads;
             s.settings.solver.method = SolverMethod::Fast;
             MassSpring fast = build_simulation(s);
-            REQUIRE(fast.plan().path == StepPath::Fast);
+            REQUIRE(fast.plan().path == StepPath::FastVerlet);
             REQUIRE(fast.plan().tethers);
             fast.run_steps(60);
             INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
@@ -151,17 +151,17 @@ TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep
     // whole boxes swept by the cloth's largest motion (the first substeps with the sphere).
     test::with_every_kernel([] {
         for (bool sphere : {false, true}) {
-            for (int threads : {1, 2, 3}) {
+            for (int threads : test::thread_counts({1, 2, 3})) {
                 Scene s = hanging(40, 0.001f);
                 test::plane(s.settings.colliders).height = -10.0f;
                 test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 20.0f, 0.0f}, 1.0f}, 0.3f, sphere};
                 s.settings.solver.threads = threads;
                 MassSpring fast = build_simulation(s);
-                REQUIRE(fast.plan().path == StepPath::Fast);
+                REQUIRE(fast.plan().path == StepPath::FastVerlet);
                 fast.run_steps(45);  // released flat, it reaches the tethers' limit as it swings down
                 int mismatched = 0, limited_substeps = 0;
                 for (int substep = 0; substep < 300; ++substep) {
-                    fast.step();
+                    fast.substep();
                     limited_substeps += fast.tethers_at_limit() > 0;
                     const CollisionBlocks& blocks = fast.collision_blocks();
                     REQUIRE(blocks.boxes_current);
@@ -240,7 +240,7 @@ TEST_CASE("tethers: a tethered pendulum released level swings down with the spee
         const double v_energy = std::sqrt(2.0 * g * L);  // no loss at all: the bound
         double lowest = 0.0, speed_at_lowest = 0.0, worst = 0.0;
         for (int sub = 0; sub < 200 * 40; ++sub) {  // 0.67 s: past the bottom (a quarter swing is 0.5 s)
-            sim.step();
+            sim.substep();
             const glm::dvec3 x = sim.state().position.get(1);
             worst = std::max(worst, glm::length(x) - L);
             if (x.y < lowest) {

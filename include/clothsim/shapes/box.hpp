@@ -21,10 +21,13 @@ struct BoxCollider {
     static constexpr std::string_view kHelp = "a solid axis-aligned box";
     static constexpr bool kHalfSpace = false;
     static constexpr float kFriction = 0.3f;
-    static constexpr std::array<ShapeField<BoxCollider>, 2> kFields = {{
-        {"center", "m", -kShapeReach, kShapeReach, "box centre", [](BoxCollider& s) -> ShapeValue { return &s.center; }},
-        {"size", "m", 0, kShapeReach, "box edge lengths along x, y, z", [](BoxCollider& s) -> ShapeValue { return &s.size; }},
-    }};
+    static constexpr std::array<ShapeField<BoxCollider>, 2> fields() {
+        // A function: its body sees the whole struct (clang rejects the members in a static initializer).
+        return {{
+            {"center", "m", -kShapeReach, kShapeReach, "box centre", [](BoxCollider& s) -> ShapeValue { return &s.center; }},
+            {"size", "m", 0, kShapeReach, "box edge lengths along x, y, z", [](BoxCollider& s) -> ShapeValue { return &s.size; }},
+        }};
+    }
 };
 
 template <class T>

@@ -24,11 +24,14 @@ struct CylinderCollider {
     static constexpr std::string_view kHelp = "a solid cylinder, axis along y (e.g. a Cusick drape tester's support disc)";
     static constexpr bool kHalfSpace = false;
     static constexpr float kFriction = 0.3f;
-    static constexpr std::array<ShapeField<CylinderCollider>, 3> kFields = {{
-        {"center", "m", -kShapeReach, kShapeReach, "cylinder centre: the middle of its axis (top face at y + height / 2)", [](CylinderCollider& s) -> ShapeValue { return &s.center; }},
-        {"radius", "m", 0, kShapeReach, "cylinder radius (a Cusick support disc: 0.09)", [](CylinderCollider& s) -> ShapeValue { return &s.radius; }},
-        {"height", "m", 0, kShapeReach, "cylinder height, bottom face to top face", [](CylinderCollider& s) -> ShapeValue { return &s.height; }},
-    }};
+    static constexpr std::array<ShapeField<CylinderCollider>, 3> fields() {
+        // A function: its body sees the whole struct (clang rejects the members in a static initializer).
+        return {{
+            {"center", "m", -kShapeReach, kShapeReach, "cylinder centre: the middle of its axis (top face at y + height / 2)", [](CylinderCollider& s) -> ShapeValue { return &s.center; }},
+            {"radius", "m", 0, kShapeReach, "cylinder radius (a Cusick support disc: 0.09)", [](CylinderCollider& s) -> ShapeValue { return &s.radius; }},
+            {"height", "m", 0, kShapeReach, "cylinder height, bottom face to top face", [](CylinderCollider& s) -> ShapeValue { return &s.height; }},
+        }};
+    }
 };
 
 // The nearest point of the solid lies on the top or bottom face, on the side, or on a rim (the circle where a

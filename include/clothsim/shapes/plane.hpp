@@ -18,9 +18,12 @@ struct PlaneCollider {
     static constexpr std::string_view kHelp = "the horizontal plane y = height, solid below (the ground)";
     static constexpr bool kHalfSpace = true;
     static constexpr float kFriction = 0.5f;
-    static constexpr std::array<ShapeField<PlaneCollider>, 1> kFields = {{
-        {"height", "m", -kShapeReach, kShapeReach, "plane height", [](PlaneCollider& s) -> ShapeValue { return &s.height; }},
-    }};
+    static constexpr std::array<ShapeField<PlaneCollider>, 1> fields() {
+        // A function: its body sees the whole struct (clang rejects the members in a static initializer).
+        return {{
+            {"height", "m", -kShapeReach, kShapeReach, "plane height", [](PlaneCollider& s) -> ShapeValue { return &s.height; }},
+        }};
+    }
 };
 
 template <class T>

@@ -5,7 +5,7 @@
 //       static constexpr bool kHalfSpace;    true when nothing can pass through it unseen (the plane): it needs
 //                                            no swept test and reads only a block's lowest point
 //       static constexpr float kFriction;    its default Coulomb coefficient
-//       static constexpr std::array kFields; its field rows: name, unit, range, help, accessor
+//       static constexpr std::array fields(); its field rows: name, unit, range, help, accessor
 //   };
 //   Contact<T> contact(const XCollider&, glm::vec<3, T> p, T thickness);      where p touches it (depth > 0)
 //   std::optional<SweptHit<T>> swept_hit(const XCollider&, p0, p1, thickness); a path through the solid

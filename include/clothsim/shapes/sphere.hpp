@@ -20,10 +20,13 @@ struct SphereCollider {
     static constexpr std::string_view kHelp = "a solid sphere";
     static constexpr bool kHalfSpace = false;
     static constexpr float kFriction = 0.3f;
-    static constexpr std::array<ShapeField<SphereCollider>, 2> kFields = {{
-        {"center", "m", -kShapeReach, kShapeReach, "sphere centre", [](SphereCollider& s) -> ShapeValue { return &s.center; }},
-        {"radius", "m", 0, kShapeReach, "sphere radius", [](SphereCollider& s) -> ShapeValue { return &s.radius; }},
-    }};
+    static constexpr std::array<ShapeField<SphereCollider>, 2> fields() {
+        // A function: its body sees the whole struct (clang rejects the members in a static initializer).
+        return {{
+            {"center", "m", -kShapeReach, kShapeReach, "sphere centre", [](SphereCollider& s) -> ShapeValue { return &s.center; }},
+            {"radius", "m", 0, kShapeReach, "sphere radius", [](SphereCollider& s) -> ShapeValue { return &s.radius; }},
+        }};
+    }
 };
 
 template <class T>

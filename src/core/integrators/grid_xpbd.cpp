@@ -1,7 +1,7 @@
-#include "grid_xpbd.hpp"
+#include "integrators/grid_xpbd.hpp"
 
-#include "fast_solver.hpp"
-#include "forces.hpp"
+#include "integrators/fast_solver.hpp"
+#include "model/forces.hpp"
 
 #include <algorithm>
 #include <omp.h>

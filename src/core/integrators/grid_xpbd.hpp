@@ -24,7 +24,7 @@
 // the violations that the residual is relative to may round differently.
 #pragma once
 
-#include "integrators.hpp"
+#include "integrators/integrators.hpp"
 
 #include <array>
 #include <optional>

@@ -1,7 +1,7 @@
-#include "integrators.hpp"
-#include "integrator_step.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/integrator_step.hpp"
 
-#include "forces.hpp"
+#include "model/forces.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -6,9 +6,9 @@
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
-#include "grid_xpbd.hpp"
-#include "integrators.hpp"
-#include "projective.hpp"
+#include "integrators/grid_xpbd.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/projective.hpp"
 
 #include <functional>
 #include <optional>

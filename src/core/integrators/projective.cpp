@@ -1,7 +1,7 @@
-#include "projective.hpp"
-#include "integrator_step.hpp"
+#include "integrators/projective.hpp"
+#include "integrators/integrator_step.hpp"
 
-#include "forces.hpp"
+#include "model/forces.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>

@@ -17,7 +17,7 @@
 
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
-#include "integrators.hpp"
+#include "integrators/integrators.hpp"
 
 #include <memory>
 

@@ -1,5 +1,5 @@
-#include "integrators.hpp"
-#include "integrator_step.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/integrator_step.hpp"
 
 namespace clothsim {
 

@@ -1,4 +1,4 @@
-#include "verlet.hpp"
+#include "integrators/verlet.hpp"
 
 namespace clothsim {
 

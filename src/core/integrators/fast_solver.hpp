@@ -27,7 +27,7 @@
 #include "clothsim/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
-#include "team_choice.hpp"
+#include "integrators/team_choice.hpp"
 
 #include <array>
 #include <functional>

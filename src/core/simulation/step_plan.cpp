@@ -53,8 +53,8 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     if (integrator_info(settings.integration.integrator).substep) {  // not Verlet: its own substep
         plan.path = StepPath::VelocityIntegrator;
     } else {
-        plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::Fast
-                                                                                 : StepPath::Textbook;
+        plan.path = fast_solver && settings.solver.method == SolverMethod::Fast ? StepPath::FastVerlet
+                                                                                 : StepPath::TextbookVerlet;
     }
     const SpringSettings& springs = settings.springs;
     const bool k[kSpringKindCount] = {springs.structural != glm::vec2(0.0f), springs.shear != 0.0f,
@@ -128,7 +128,7 @@ std::string_view state_name(StageState state) {
 std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology, const SimulationSettings& settings) {
     using enum StageState;
     std::vector<StageStatus> out;
-    const bool fast = plan.path == StepPath::Fast;
+    const bool fast = plan.path == StepPath::FastVerlet;
     const bool velocity = plan.path == StepPath::VelocityIntegrator;
     const std::string springs = spring_note(plan, topology);
     auto when = [](bool runs, StageState otherwise) { return runs ? Runs : otherwise; };

@@ -1,4 +1,4 @@
-#include "forces.hpp"
+#include "model/forces.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -1,4 +1,4 @@
-#include "penalty_contact.hpp"
+#include "collision/penalty_contact.hpp"
 
 #include "clothsim/collider.hpp"
 

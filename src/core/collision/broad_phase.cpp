@@ -1,6 +1,6 @@
 #include "clothsim/broad_phase.hpp"
 
-#include "fast_solver.hpp"
+#include "integrators/fast_solver.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>

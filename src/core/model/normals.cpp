@@ -1,6 +1,6 @@
 #include "clothsim/normals.hpp"
 
-#include "fast_solver.hpp"
+#include "integrators/fast_solver.hpp"
 
 #include <glm/geometric.hpp>
 

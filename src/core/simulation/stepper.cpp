@@ -63,7 +63,7 @@ StepReport Stepper::run(MassSpring& sim, long long steps) {
     StepReport report;
     choose_substeps(sim);
     if (steps <= 0) return report;
-    if (!sim.resting() && !sim.all_finite()) {
+    if (!sim.asleep() && !sim.all_finite()) {
         report.skipped_non_finite = true;
         return report;
     }

@@ -369,7 +369,7 @@ std::vector<ColliderField> collider_fields(Collider& collider) {
         {"friction", "", 0, 10, "Coulomb friction coefficient (0 = frictionless)", &collider.friction},
     };
     std::visit([&]<class Shape>(Shape& shape) {
-        for (const ShapeField<Shape>& f : Shape::kFields) {
+        for (const ShapeField<Shape>& f : Shape::fields()) {
             rows.push_back({f.name, f.unit, f.min, f.max, f.help,
                             std::visit([](auto* v) -> FieldRef { return v; }, f.ref(shape))});
         }

@@ -3,12 +3,12 @@
 #include "clothsim/colliders.hpp"
 #include "clothsim/tearing.hpp"
 #include "clothsim/tethers.hpp"
-#include "forces.hpp"
-#include "fast_solver.hpp"
+#include "model/forces.hpp"
+#include "integrators/fast_solver.hpp"
 #include "integrators/grid_xpbd.hpp"
 #include "integrators/integrator_step.hpp"
 #include "integrators/integrators.hpp"
-#include "penalty_contact.hpp"
+#include "collision/penalty_contact.hpp"
 #include "integrators/projective.hpp"
 #include "integrators/verlet.hpp"
 
@@ -115,7 +115,7 @@ bool MassSpring::use_fast_kernel(const std::string& name) {
 }
 
 int MassSpring::solver_threads() const {
-    if (plan_.path != StepPath::Fast) {
+    if (plan_.path != StepPath::FastVerlet) {
         const bool grid = last_step_fast() && iterative_.data->grid_xpbd;
         return grid ? iterative_.data->grid_xpbd->effective_threads(settings_.solver.threads) : 1;
     }
@@ -124,7 +124,7 @@ int MassSpring::solver_threads() const {
 }
 
 bool MassSpring::last_step_fast() const {
-    if (plan_.path == StepPath::Fast) return true;
+    if (plan_.path == StepPath::FastVerlet) return true;
     return settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd &&
            iterative_.data->grid_xpbd_ran;
 }
@@ -163,30 +163,30 @@ void MassSpring::set_substeps(int substeps) {
 
 // The whole pipeline of one substep, in order. The stages come from the plan (step_plan.hpp), made when the
 // settings were applied; a stage the plan leaves out is not run, not even as a branch per particle.
-void MassSpring::step() {
+void MassSpring::substep() {
     const double h = substep_length();
-    if (asleep_) {
+    if (sleep_.asleep()) {
         state_.time += h;
         ++profile_.slept_substeps;
         return;
     }
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
-    blocks_.current = blocks_.boxes_current = false;  // positions move now: last substep's boxes are stale
+    blocks_.positions_moving();
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
     const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
-    if (!continues) blocks_.carried_valid = false;     // an edit may have moved particles out of it
+    if (!continues) blocks_.moved_outside_motion();    // an edit may have moved particles
     // A dragged pin moves outside the motions the broad phase and self-collision count.
     if (!pin_targets_.empty() && move_dragged_pins()) {
-        blocks_.carried_valid = false;
+        blocks_.moved_outside_motion();
         if (self_collision_) self_collision_->invalidate();
     }
     // Self-collision's list of near pairs holds while only steps move the particles (self_collision.hpp).
     if (!continues && self_collision_) self_collision_->invalidate();
 
     switch (plan_.path) {
-        case StepPath::Fast: step_fast(h, profile); break;
-        case StepPath::Textbook: step_textbook(h, profile); break;
+        case StepPath::FastVerlet: step_fast(h, profile); break;
+        case StepPath::TextbookVerlet: step_textbook(h, profile); break;
         case StepPath::VelocityIntegrator: {
             StageTimer timer(profile, Stage::Integrate);
             step_velocity_integrator(integrator, h, continues);
@@ -194,7 +194,7 @@ void MassSpring::step() {
     }
     // The fast solver's sweep may have taken the bounds of the motion it wrote; they hold until a stage moves a
     // particle.
-    const bool swept_bounds = plan_.path == StepPath::Fast && sweep_takes_motion_bounds();
+    const bool swept_bounds = plan_.path == StepPath::FastVerlet && sweep_takes_motion_bounds();
     const bool collided = collide(profile, swept_bounds ? &motion_bounds_ : nullptr);
     const MotionBounds* known = swept_bounds && !collided ? &motion_bounds_ : nullptr;
     // Moves outside the motions, which self-collision's budget does not count: a collider's push now, what
@@ -218,13 +218,13 @@ void MassSpring::step() {
             StageTimer timer(profile, Stage::SpeedLimit);
             limited = limit_speed(h) || limited;
         }
-        if (self_moved || limited) blocks_.carried_valid = false;  // pushes and limits may leave it; tethers do not
+        if (self_moved || limited) blocks_.moved_outside_motion();  // pushes and limits; tethers stay inside it
         if (plan_.tethers && tethers_at_limit_ > 0 && blocks_.carried_valid) {
             // A tether keeps its particle in the carried box but takes the outward part of its motion, which
             // moves the start of its path (x - motion, where the swept tests begin) by at most that motion.
             blocks_.widen_carried(swept_bounds && !collided ? motion_bounds_.largest() : NAN);
         }
-        blocks_.current = false;
+        blocks_.positions_moving();
         blocks_.boxes_current = box_blocks_on_team(profile);
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
         moved_uncounted_ = pushed || limited || (plan_.tethers && tethers_at_limit_ > 0);
@@ -241,7 +241,7 @@ void MassSpring::step() {
         }
         if (plan_.may_sleep) {
             StageTimer timer(profile, Stage::Sleep);
-            check_sleep(h);
+            sleep_.check(state_, settings_.solver, h, !pin_targets_.empty());  // a pin on its way drives the cloth
         }
     }
 }
@@ -299,7 +299,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
 // number of threads.
 std::size_t MassSpring::apply_tethers() {
     const double strain = settings_.springs.tether_strain;
-    if (plan_.path != StepPath::Fast || !fast_.solver) return project_tethers(state_, tethers_, strain);
+    if (plan_.path != StepPath::FastVerlet || !fast_.solver) return project_tethers(state_, tethers_, strain);
     std::array<std::size_t, 64> active{};
     const auto cols = static_cast<std::uint32_t>(topology_.cols);
     fast_.solver->for_each_block([&](int block, int begin, int end) {
@@ -315,7 +315,7 @@ std::size_t MassSpring::apply_tethers() {
 // The same split for the boxes of the collision broad phase's blocks (block_starts' grid layout, row by
 // row), which the collision stage would otherwise make again block by block on one thread.
 bool MassSpring::box_blocks_on_team(StepProfile* profile) {
-    if (plan_.path != StepPath::Fast || !fast_.solver || !plan_.colliders || !settings_.solver.broad_phase) {
+    if (plan_.path != StepPath::FastVerlet || !fast_.solver || !plan_.colliders || !settings_.solver.broad_phase) {
         return false;
     }
     StageTimer timer(profile, Stage::BroadPhase);
@@ -340,7 +340,7 @@ bool MassSpring::sweep_takes_motion_bounds() const {
 
 bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
     if (!plan_.colliders) {
-        blocks_.carried_valid = false;  // not grown while no stage reads it
+        blocks_.moved_outside_motion();  // not grown while no stage reads it
         return false;
     }
     return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads(),
@@ -417,45 +417,8 @@ void MassSpring::replan() {
 }
 
 void MassSpring::wake() {
-    calm_seconds_ = 0.0;
     substeps_since_check_ = 0;
-    sleep_reference_ = DVec3Array{};  // the next check starts a new baseline
-    if (!asleep_) return;
-    asleep_ = false;
-    restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
-}
-
-// Once per step. A particle's speed is its displacement since the last check over the time between: a
-// step-long baseline, because float round-off keeps stiff springs jittering from substep to substep at a
-// few mm/s (measured on the hanging scene: 2.3 mm/s at rest) while the step-to-step drift of a cloth at rest
-// is far smaller. So a vibration the baseline could alias away cannot sleep either, no particle's substep
-// motion may exceed kSubstepFactor x sleep_speed. NaN never counts as calm.
-void MassSpring::check_sleep(double h) {
-    constexpr double kSubstepFactor = 100.0;
-    const std::size_t n = state_.size();
-    const double elapsed = state_.time - sleep_reference_time_;
-    if (sleep_reference_.size() != n || !(elapsed > 0.0)) {
-        sleep_reference_ = state_.position;
-        sleep_reference_time_ = state_.time;
-        return;
-    }
-    const double step_limit = settings_.solver.sleep_speed * elapsed;
-    const double substep_limit = kSubstepFactor * settings_.solver.sleep_speed * h;
-    const double step2 = step_limit * step_limit, substep2 = substep_limit * substep_limit;
-    bool calm = pin_targets_.empty();  // a pin still on its way drives the cloth
-    for (std::size_t i = 0; i < n && calm; ++i) {
-        if (state_.pinned[i]) continue;
-        const glm::dvec3 d = state_.position.get(i) - sleep_reference_.get(i);
-        const glm::dvec3 m = state_.motion.get(i);
-        calm = glm::dot(d, d) < step2 && glm::dot(m, m) < substep2;  // false for NaN
-    }
-    calm_seconds_ = calm ? calm_seconds_ + elapsed : 0.0;
-    sleep_reference_ = state_.position;
-    sleep_reference_time_ = state_.time;
-    if (calm && calm_seconds_ + 1e-9 >= settings_.solver.sleep_time) {
-        asleep_ = true;
-        for (std::size_t i = 0; i < n; ++i) state_.motion.set(i, glm::dvec3(0.0));
-    }
+    if (sleep_.wake()) restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
 }
 
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
@@ -527,7 +490,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
         if (grab_) f.add(grab_->particle, grab_force(state_));
     };
     const IntegratorInfo& info = integrator_info(integrator);
-    if (!info.substep) return;  // Verlet: step() runs the fast solver or the textbook path
+    if (!info.substep) return;  // Verlet: substep() runs the fast solver or the textbook path
     info.substep(context);
     if (info.reports_solve) {
         last_iterations_ = context.solve.iterations;
@@ -569,7 +532,7 @@ void MassSpring::grab(std::size_t i, glm::vec3 target) {
     if (state_.pinned.at(i)) return;
     wake();
     if (!grab_ || grab_->particle != i) {
-        grab_ = Grab{i, target, grab_force_limit(i)};
+        grab_ = GrabSpring{i, target, grab_force_limit(i)};
         grab_external_ = Vec3Array{};
         grab_external_.resize(state_.size());
     }
@@ -595,19 +558,7 @@ void MassSpring::release_grab() {
 
 glm::vec3 MassSpring::grab_force() const { return grab_ ? grab_force(state_) : glm::vec3(0.0f); }
 
-// F = k (target - x) - c v, k = m / (4 h^2), c = 2 sqrt(k m) (critical), |F| capped at force_limit.
-glm::vec3 MassSpring::grab_force(const State& state) const {
-    const std::size_t i = grab_->particle;
-    const double h = substep_length();
-    const double m = state.mass[i];
-    const double k = 0.25 * m / (h * h);
-    const double c = 2.0 * std::sqrt(k * m);
-    const glm::dvec3 velocity = state.motion.get(i) / (state.substep > 0.0 ? state.substep : h);
-    glm::dvec3 f = k * (glm::dvec3(grab_->target) - state.position.get(i)) - c * velocity;
-    const double length = glm::length(f);
-    if (!(length <= grab_->force_limit)) f *= length > 0.0 ? grab_->force_limit / length : 0.0;
-    return glm::vec3(f);
-}
+glm::vec3 MassSpring::grab_force(const State& state) const { return grab_->force(state, substep_length()); }
 
 // XPBD's residual is measured when asked, at the positions now (after collisions and limits): the step
 // itself pays nothing for it.
@@ -622,7 +573,7 @@ double MassSpring::last_solver_residual() const {
 
 void MassSpring::run_steps(long long steps) {
     for (long long s = 0; s < steps; ++s) {
-        for (int i = 0; i < settings_.integration.substeps; ++i) step();
+        for (int i = 0; i < settings_.integration.substeps; ++i) substep();
     }
 }
 
@@ -664,7 +615,7 @@ std::vector<glm::vec3> MassSpring::velocities() const {
 }
 
 std::vector<glm::dvec3> MassSpring::velocities_in_double() const {
-    if (asleep_) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
+    if (sleep_.asleep()) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
     if (integrator_info(state_.integrator).keeps_velocity) {
         std::vector<glm::dvec3> v(state_.size(), glm::dvec3(0.0));
         if (state_.substep > 0.0) {

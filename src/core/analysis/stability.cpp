@@ -1,7 +1,7 @@
 #include "clothsim/stability.hpp"
 
-#include "forces.hpp"
-#include "penalty_contact.hpp"
+#include "model/forces.hpp"
+#include "collision/penalty_contact.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -219,7 +219,7 @@ std::string what_bounds(const MassSpring& sim) {
 // stability bound asks for).
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
     for (long long done = 0; done < steps; ++done) {
-        if (sim.resting()) {  // asleep with nothing to wake it: the step moves nothing, there is nothing to check
+        if (sim.asleep()) {  // asleep with nothing to wake it: the step moves nothing, there is nothing to check
             sim.run_steps(1);
             continue;
         }

@@ -1,4 +1,4 @@
-#include "fast_solver.hpp"
+#include "integrators/fast_solver.hpp"
 
 #include "clothsim/broad_phase.hpp"
 #include "integrators/verlet.hpp"

@@ -2,9 +2,9 @@
 
 #include "clothsim/colliders.hpp"
 #include "clothsim/scene.hpp"
-#include "forces.hpp"
+#include "model/forces.hpp"
 #include "integrators/integrators.hpp"
-#include "penalty_contact.hpp"
+#include "collision/penalty_contact.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -387,7 +387,8 @@ void load_collider(Collider& collider, const toml::table& table, const std::stri
         if (key.str() == "kind") continue;
         const std::string field_name = name + "." + std::string(key.str());
         const auto rows = collider_fields(collider);
-        const auto row = std::find_if(rows.begin(), rows.end(), [&](const ColliderField& f) { return f.name == key.str(); });
+        const std::string_view wanted = key.str();  // a name, not the binding: clang 14 cannot capture those
+        const auto row = std::find_if(rows.begin(), rows.end(), [&](const ColliderField& f) { return f.name == wanted; });
         if (row == rows.end()) {
             throw SceneError(where(source, node) + ": unknown field '" + field_name + "'; known fields of a " +
                              std::string(kind_name(collider)) + ": " + collider_field_names(collider));

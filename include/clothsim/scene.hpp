@@ -68,7 +68,8 @@ struct ColliderField {
     FieldRef ref;  // into the collider
 };
 std::vector<ColliderField> collider_fields(Collider& collider);
-// The rows of a kind as a default collider of it holds them (for listings: --list-fields, the docs).
+// The rows of a kind as a default collider of it holds them (for listings: --list-fields, the docs); read
+// them only, never write through their references.
 std::vector<ColliderField> collider_fields_of_kind(std::size_t kind);
 std::string describe_allowed(const ColliderField& field);
 std::string format_value(const ColliderField& field);

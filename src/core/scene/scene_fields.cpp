@@ -378,10 +378,15 @@ std::vector<ColliderField> collider_fields(Collider& collider) {
 }
 
 std::vector<ColliderField> collider_fields_of_kind(std::size_t kind) {
-    // The rows' names, units, ranges and help are static; only their references would point at the scratch.
-    thread_local Collider scratch;
-    scratch = default_collider(kind);
-    return collider_fields(scratch);
+    // One default collider per kind, made once and never written: the rows' references stay valid while the
+    // program runs, whichever kind is asked for next (a shared scratch rewritten per call would leave an
+    // earlier call's references pointing into a shape of another kind).
+    static const std::array<Collider, kColliderKindCount> defaults = [] {
+        std::array<Collider, kColliderKindCount> all;
+        for (std::size_t k = 0; k < kColliderKindCount; ++k) all[k] = default_collider(k);
+        return all;
+    }();
+    return collider_fields(const_cast<Collider&>(defaults[kind]));
 }
 
 std::string describe_allowed(const ColliderField& field) {

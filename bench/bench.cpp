@@ -35,7 +35,7 @@ namespace {
 using namespace clothsim;
 using Clock = std::chrono::steady_clock;
 
-// The base scene resized. A bundled scene runs in its per-spring form (tests/per_spring_scenes.hpp), the workload
+// The base scene resized. A bundled scene runs in its per-spring form (tests/fixtures/per_spring_scenes.hpp), the workload
 // the recorded figures measured, so they stay comparable after the scenes moved to [material].
 // Its substeps are set to 0.7 of the critical substep on the resized grid (as --auto-substeps 0.7 does; the
 // timed cost of one substep does not depend on their number): at the file's own substeps, `hanging` resized

@@ -3,7 +3,7 @@
 // textbook Verlet update, collisions with a sphere the cloth lies on, and the renderer's vertex normals. And
 // what the fast solver's threads cost per substep with no work at all: the parallel region it opens each
 // substep against the barriers one region per step would need instead (docs/PERFORMANCE.md).
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
@@ -18,7 +18,7 @@ namespace {
 
 using namespace clothsim;
 
-// hanging in its per-spring form (tests/per_spring_scenes.hpp): the kernels' recorded workload, at 0.7 of the
+// hanging in its per-spring form (tests/fixtures/per_spring_scenes.hpp): the kernels' recorded workload, at 0.7 of the
 // critical substep on the resized grid (at the file's substeps a large grid becomes non-finite in its first
 // step, and NaN arithmetic is no measure of a kernel) and never asleep.
 MassSpring hanging(int size, SolverMethod method, int threads) {

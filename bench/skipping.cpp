@@ -5,7 +5,6 @@
 
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
-#include "clothsim/self_collision.hpp"
 #include "clothsim/stability.hpp"
 
 #include "per_spring_scenes.hpp"
@@ -85,7 +84,7 @@ Pair time_pair(const std::function<void()>& frame_a, const std::function<void()>
 
 // A bundled scene with its cloth resized, and the substeps a finer grid needs to stay stable (0.67 of the
 // critical substep, as the bundled scenes are set).
-// In its per-spring form (tests/per_spring_scenes.hpp): the workload docs/PERFORMANCE.md's figures measured,
+// In its per-spring form (tests/fixtures/per_spring_scenes.hpp): the workload docs/PERFORMANCE.md's figures measured,
 // and the zero-stiffness cases switch skip-one bending springs off.
 Scene resized(const std::string& name, int size) {
     Scene s = per_spring_scene(name);
@@ -299,7 +298,7 @@ int run_skipping(const SkippingOptions& o) {
             p.b = "collision.self on";
             char note[200];
             std::snprintf(note, sizeof note, "self collision stage %.3f ms/frame; %lld of %lld substeps tested, %lld tiles in the narrow phase",
-                          median(self_ms), b.profile().self_tiles / (64 / kSelfTile * 64 / kSelfTile), b.profile().substeps,
+                          median(self_ms), b.profile().self_tests, b.profile().substeps,
                           b.profile().self_tiles_active);
             p.note = note;
             p.a_ms /= frames;

@@ -15,7 +15,7 @@
 // failed, 2 for a usage or scene error. scripts/soak runs the full 10^6-step soak; tests/soak the short one.
 #include "csv.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "clothsim/collider.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
@@ -165,7 +165,7 @@ struct Options {
 };
 
 Result soak(const SoakScene& which, const Options& opt, std::ofstream& csv) {
-    // A bundled scene in its per-spring form (tests/per_spring_scenes.hpp): the recorded soaks' workload.
+    // A bundled scene in its per-spring form (tests/fixtures/per_spring_scenes.hpp): the recorded soaks' workload.
     Scene scene = load_per_spring(which.scene);
     const ColliderSettings& bundled = scene.settings.colliders;
     // The key names a first-form section (sphere, cube, ground): its kind must be enabled in the scene.

@@ -28,7 +28,7 @@ using Clock = std::chrono::steady_clock;
 constexpr float kStep = 1.0f / 60.0f;  // s: one step (an app frame); the sweep divides it into substeps
 
 // The smooth scene: the bundled hanging cloth at 32 x 32 without the ground (damping 0.2 as in the file), in
-// the per-spring form docs/ACCURACY.md's figures measured (tests/per_spring_scenes.hpp).
+// the per-spring form docs/ACCURACY.md's figures measured (tests/fixtures/per_spring_scenes.hpp).
 Scene sweep_scene() {
     Scene s = per_spring_scene("hanging");
     s.cloth.rows = s.cloth.cols = 32;

@@ -23,7 +23,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The study's scenes: small versions of bundled ones, so the double-precision reference is affordable, in the
-// per-spring form docs/ACCURACY.md's figures measured (tests/per_spring_scenes.hpp).
+// per-spring form docs/ACCURACY.md's figures measured (tests/fixtures/per_spring_scenes.hpp).
 //  smooth: hanging, 16 x 16, no ground, no damping (smooth and conservative: energy error is meaningful)
 //  drape:  drape-sphere, 16 x 16, damped, with sphere and ground contact, penalty model (smooth; see below)
 //  flag:   flag, 12 x 18, wind with gusts

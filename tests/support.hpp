@@ -123,8 +123,10 @@ inline Scene disc_specimen(int n) {
 // steps or frames there (kLoopShare); the Release suite runs them whole and checks the physics.
 #if defined(__SANITIZE_ADDRESS__)
 inline constexpr int kLoopShare = 4;
+inline constexpr bool kSanitized = true;
 #else
 inline constexpr int kLoopShare = 1;
+inline constexpr bool kSanitized = false;
 #endif
 
 // The bundled scenes that cost far more per step than the others, and how the tests that run every bundled

@@ -41,7 +41,7 @@ struct IntegratorInfo {
     double spring_factor;         // explicit springs: h_crit = factor / omega
     bool explicit_damping;        // its damping term is forward Euler on a decay rate (stability.hpp: DampingForm)
     double damping_limit;         // its damping alone is stable while c h < this (0: no such limit)
-    bool holds_implicit;          // soft clips' holds are in its matrix: they bound no substep
+    bool soft_clips_implicit;          // soft clips' holds are in its matrix: they bound no substep
     // State::motion: v h (keeps_velocity), or x - x_prev (Verlet's); and whether that is the substep's
     // displacement, which continuous collision sweeps and self-collision counts (RK4's and projective's v h at
     // the substep's end is not).

@@ -20,17 +20,12 @@
 // it, and it restarts from rest.
 #pragma once
 
-#include "clothsim/grab_spring.hpp"
+#include "clothsim/cloth_surface.hpp"
 #include "clothsim/particle.hpp"
-#include "clothsim/sleep_monitor.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 #include "clothsim/step_plan.hpp"
 #include "clothsim/step_profile.hpp"
-#include "clothsim/cloth_surface.hpp"
-#include "clothsim/colliders.hpp"
-#include "clothsim/self_collision.hpp"
-#include "clothsim/tethers.hpp"
 
 #include <glm/vec3.hpp>
 
@@ -54,7 +49,8 @@ struct Energy {
     double total() const { return kinetic + potential(); }
 };
 
-class FastSolver;
+struct CollisionBlocks;
+struct MotionBounds;
 
 class MassSpring {
 public:
@@ -105,16 +101,14 @@ public:
     bool all_finite() const;
     // Whether settings().solver.method == Fast can run the fast solver (it needs a grid topology; it
     // runs position Verlet), and with how many threads the current settings step.
-    bool fast_solver_available() const { return fast_.solver != nullptr; }
+    bool fast_solver_available() const;
     int solver_threads() const;
-    // The collision broad phase's blocks and their boxes as the last substep left them (for tests).
-    const CollisionBlocks& collision_blocks() const { return blocks_; }
     // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
     // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth).
     bool last_step_fast() const;
     // Tethers to the pins (tethers.hpp; they act when springs.tether_strain > 0), and how many were at their
     // limit in the last substep.
-    std::size_t tether_count() const { return tethers_.size(); }
+    std::size_t tether_count() const;
     std::size_t tethers_at_limit() const { return tethers_at_limit_; }
     // Springs (and bends) broken by tearing since the cloth was built (springs.tear_strain; tearing.hpp).
     std::size_t broken_springs() const { return broken_springs_; }
@@ -145,9 +139,9 @@ public:
     void set_profiling(bool on) { profiling_ = on; }
 
     // Asleep: the next step will not move anything (every change that could move the cloth wakes it).
-    bool asleep() const { return sleep_.asleep(); }
+    bool asleep() const;
     // s: how long the cloth has stayed under sleep_speed (it sleeps at solver.sleep_time).
-    double calm_seconds() const { return sleep_.calm_seconds(); }
+    double calm_seconds() const;
     // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
     void wake();
     // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
@@ -191,10 +185,10 @@ public:
     // again moves the target; it wakes the cloth. A pinned particle is moved with move_pinned instead.
     void grab(std::size_t i, glm::vec3 target);
     void release_grab();
-    std::optional<std::size_t> grabbed() const { return grab_ ? std::optional<std::size_t>(grab_->particle) : std::nullopt; }
+    std::optional<std::size_t> grabbed() const;
     // N: the grab's force on the grabbed particle at the current state (0 without a grab), and its cap.
     glm::vec3 grab_force() const;
-    float grab_force_limit() const { return grab_ ? grab_->force_limit : 0.0f; }
+    float grab_force_limit() const;
     // A cut (the app's shift + right-drag): breaks every spring for which crosses(position a, position b) is
     // true, with the bends, bending springs and triangles that bridge it, as a tear does (tearing.hpp), and
     // wakes the cloth. Returns how many springs (bends included) broke.
@@ -249,40 +243,29 @@ private:
     // Where pin i may go on its way to `x`, within reach of the other pins (drag_pin).
     glm::dvec3 within_reach_of_pins(std::size_t i, glm::dvec3 from, glm::dvec3 x) const;
 
-    // Holds the fast solver (internal to src/core, so held by pointer); copies of the simulation copy it.
-    struct FastSolverHolder {
-        std::unique_ptr<FastSolver> solver;
-        FastSolverHolder();
-        explicit FastSolverHolder(std::unique_ptr<FastSolver> s);
-        FastSolverHolder(const FastSolverHolder& other);
-        FastSolverHolder& operator=(const FastSolverHolder& other);
-        FastSolverHolder(FastSolverHolder&&) noexcept;
-        FastSolverHolder& operator=(FastSolverHolder&&) noexcept;
-        ~FastSolverHolder();
+    // Everything else the simulation keeps (src/core/simulation/mass_spring_internals.hpp): the solvers' caches,
+    // the collision blocks, self-collision, tethers, the grab, dragged pins, the sleep monitor. Held by a
+    // pointer that copies what it points to, so a copy of the simulation carries all of it.
+    struct Internals;
+    class InternalsPtr {
+    public:
+        InternalsPtr();
+        InternalsPtr(const InternalsPtr& other);
+        InternalsPtr& operator=(const InternalsPtr& other);
+        InternalsPtr(InternalsPtr&&) noexcept;
+        InternalsPtr& operator=(InternalsPtr&&) noexcept;
+        ~InternalsPtr();
+        Internals* operator->() const { return p_.get(); }
+        Internals& operator*() const { return *p_; }
+    private:
+        std::unique_ptr<Internals> p_;
     };
-
-    // What the iterative integrators keep between substeps (internal to src/core, so held by pointer): the
-    // projective solver's factorised matrix and BDF2 history (projective.hpp), XPBD's multipliers
-    // (integrators.hpp) and its grid form (grid_xpbd.hpp). Copies of the simulation copy it.
-    struct IterativeSolvers {
-        struct Data;
-        std::unique_ptr<Data> data;
-        IterativeSolvers();
-        IterativeSolvers(const IterativeSolvers& other);
-        IterativeSolvers& operator=(const IterativeSolvers& other);
-        IterativeSolvers(IterativeSolvers&&) noexcept;
-        IterativeSolvers& operator=(IterativeSolvers&&) noexcept;
-        ~IterativeSolvers();
-        // The stiffness, the substep, the pins or the topology changed: the projective solver factorises
-        // again and XPBD's grid form is made again, at the next step that uses them.
-        void invalidate();
-    };
+    friend const CollisionBlocks& collision_blocks(const MassSpring& sim);
 
     Topology topology_;
+    InternalsPtr in_;
     State state_;
     SimulationSettings settings_;
-    FastSolverHolder fast_;      // the fast solver, when the topology is a grid
-    IterativeSolvers iterative_;
     std::uint64_t history_stamp_ = 0;  // stamp_ as the last substep left it; 0 after a restart
     std::size_t broken_springs_ = 0;
     std::uint64_t topology_stamp_ = 0;
@@ -291,30 +274,17 @@ private:
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;
-    CollisionBlocks blocks_;     // particle blocks and their boxes for the collision broad phase
-    MotionBounds motion_bounds_; // the fast solver's bounds of this substep's motion (sweep_takes_motion_bounds)
     Vec3Array force_;            // N, scratch of the current substep
     Vec3Array external_;         // N, scratch: wind and contact summed on their own before they are added
     float rest_area_ = 0.0f;     // m^2: sum of the triangles' rest areas
     double spacing_ = 0.0;       // m: particle_spacing() of the cloth as built
     DVec3Array rest_position_;   // m: the positions the cloth was built with (flat, at rest)
-    Tethers tethers_;            // to the current pins, rebuilt when a pin is set or freed
-    std::optional<SelfCollision> self_collision_;  // built when collision.self is first on
-    bool moved_uncounted_ = false;  // the last substep moved particles after its self stage, outside their motion
     std::size_t tethers_at_limit_ = 0;
     int last_iterations_ = 0;
     double last_residual_ = 0.0;
-    SleepMonitor sleep_;
     int substeps_since_check_ = 0;
     std::uint64_t stamp_ = 0;
     std::uint64_t setup_stamp_ = 0;
-    std::optional<GrabSpring> grab_;
-    struct PinTarget {
-        std::size_t particle = 0;
-        glm::dvec3 target{0.0};  // m
-        double reach = 0.0;      // m per substep
-    };
-    std::vector<PinTarget> pin_targets_;  // pins dragged toward a target (drag_pin), at most a few
     Vec3Array grab_external_;    // N: the grab's and soft clips' forces (zero elsewhere), for the fast solver
 };
 

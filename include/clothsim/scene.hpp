@@ -84,7 +84,7 @@ Collider& first_form_collider(ColliderSettings& colliders, std::string_view sect
 
 // ---- Names of the enumerations, as written in files. ----
 std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
-std::span<const std::string_view> clip_hold_names();    // rigid, soft
+std::span<const std::string_view> clip_kind_names();    // rigid, soft
 std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook
 std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd

@@ -19,11 +19,11 @@ namespace clothsim {
 
 // Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
 enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
-// How a clip (a pin with a radius) holds: Rigid pins every particle within the radius; Soft holds each to
+// The kind of clip (a pin with a radius; Pin): Rigid pins every particle within the radius; Soft holds each to
 // where it is at rest by a zero-length spring whose stiffness fades to 0 at the rim (docs/MATERIAL.md,
 // "Soft clips"): the load enters the cloth smoothly, and a cloth held in the plane it hangs in has a largest
 // strain that converges as the grid is refined.
-enum class ClipHold { Rigid, Soft };
+enum class ClipKind { Rigid, Soft };
 
 // The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,
 // projective).
@@ -111,19 +111,19 @@ struct ForceSettings {
 // One pin: the particle (row, col) alone, or a clip that holds every particle whose rest position lies within
 // `radius` of that particle's (a real cloth is held by a clip of finite size; a single pinned particle is a
 // point load whose strain grows without bound as the grid is refined).
-struct PinClip {
+struct Pin {
     int row = 0;
     int col = 0;
     float radius = 0.0f;  // m: 0 = this particle only
-    bool operator==(const PinClip&) const = default;
+    bool operator==(const Pin&) const = default;
 };
 
 // Which particles are pinned: a named preset and/or explicit pins.
 struct PinSpec {
     PinPreset preset = PinPreset::TopCorners;
-    std::vector<PinClip> particles;  // in addition to the preset
+    std::vector<Pin> particles;  // in addition to the preset
     float preset_radius = 0.0f;      // m: each pin of the preset is a clip of this radius (0 = point pins)
-    ClipHold clip = ClipHold::Rigid;  // how every clip holds (point pins are always rigid)
+    ClipKind clip = ClipKind::Rigid;  // how every clip holds (point pins are always rigid)
     bool operator==(const PinSpec&) const = default;
 };
 

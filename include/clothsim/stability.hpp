@@ -24,7 +24,7 @@ namespace clothsim {
 
 // What sets the critical substep: the springs (explicit integrators), or, where the springs are implicit,
 // XPBD's explicit damping (c h < 2), penalty contact or soft clips (a force every integrator takes explicitly).
-enum class StabilityBound { Springs, Damping, Contact, Clips };
+enum class StabilityBound { Springs, Damping, Contact, SoftClips };
 
 struct StabilityLimit {
     double omega_gershgorin = 0.0;  // rad/s, the safe bound on the fastest mode

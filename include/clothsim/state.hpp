@@ -55,10 +55,10 @@ using DVec3Array = BasicVec3Array<double>;
 inline constexpr std::uint8_t kPinned = 1;
 inline constexpr std::uint8_t kAbsent = 2;
 
-// A particle of a soft clip (ClipHold::Soft), held to its anchor, where it lay at rest, by a zero-length
+// A particle of a soft clip (ClipKind::Soft), held to its anchor, where it lay at rest, by a zero-length
 // spring: F = -k (x - anchor), k = max(k_u share_u, k_v share_v) with k_u, k_v the structural springs' constants
 // (kept up to date when they change; cloth_builder.cpp has the shares).
-struct Hold {
+struct SoftClipSpring {
     std::uint32_t particle = 0;
     float stiffness = 0.0f;  // N/m
     glm::dvec3 anchor{0.0};  // m
@@ -73,7 +73,7 @@ struct Topology {
     int cols = 0;
     std::vector<Spring> springs;
     std::vector<Bend> bends;  // the material form's bending (kind Bending); the per-spring form has none
-    std::vector<Hold> holds;  // soft clips' particles (pins with clip = "soft")
+    std::vector<SoftClipSpring> clip_springs;  // soft clips' particles (pins with clip = "soft")
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
     // The triangles are every grid cell's two, in row-major cell order: (00, 01, 10) and (01, 11, 10) for the
     // cell's corners (row, col) = 00. The builder sets it for rectangles; normals.cpp then sweeps the grid.

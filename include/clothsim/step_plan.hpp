@@ -32,7 +32,7 @@ struct StepPlan {
     std::array<bool, kSpringKindCount> springs{};  // a kind runs: it has springs and a non-zero stiffness
     bool wind = false;
     bool contact = false;  // penalty contact: a force stage (colliders.contact = penalty, a collider enabled)
-    bool holds = false;    // soft clips hold particles: a force stage
+    bool soft_clips = false;  // soft clips hold particles: a force stage
     bool colliders = false;  // the projection stage (projection contact, a collider enabled)
     bool solids = false;     // ... and a solid shape among them (not only planes): the blocks need whole boxes
     bool tethers = false;  // springs.tether_strain > 0 and the cloth has pins to tie to
@@ -44,7 +44,7 @@ struct StepPlan {
 
     bool any_springs() const { return springs[0] || springs[1] || springs[2]; }
     // Forces besides the springs, gravity, damping and a grab, added on their own (add_external_forces).
-    bool external_forces() const { return wind || contact || holds; }
+    bool external_forces() const { return wind || contact || soft_clips; }
     // Bit k set when spring kind k runs: the fast solver's variant.
     unsigned spring_mask() const { return (springs[0] ? 1u : 0u) | (springs[1] ? 2u : 0u) | (springs[2] ? 4u : 0u); }
 };

@@ -18,7 +18,7 @@ enum class Stage {
     Springs,     // spring forces (textbook solver and velocity integrators)
     Wind,        // wind forces
     Contact,     // penalty contact forces (colliders.contact = penalty; penalty_contact.hpp)
-    Clips,       // soft clips' holding forces (pins.clip = "soft")
+    SoftClips,   // soft clips' holding forces (pins.clip = "soft")
     Fast,        // fast solver: springs, gravity, damping and the Verlet update, fused row by row
     Integrate,   // the integrator's update (textbook Verlet, or a whole velocity-integrator substep)
     BroadPhase,  // boxes of the particle blocks (when the fast solver did not leave them) and of the whole cloth
@@ -44,8 +44,9 @@ struct StepProfile {
     // met a collider of that kind and were tested particle by particle, out of all blocks offered to them.
     std::array<long long, kColliderKindCount> blocks_tested{};
     std::array<long long, kColliderKindCount> blocks_offered{};
-    // Self-collision: tiles boxed, tiles sent to the narrow phase, particle pairs pushed apart.
-    long long self_tiles = 0, self_tiles_active = 0, self_contacts = 0;
+    // Self-collision: substeps it tested (it skips those whose motion cannot close a gap), tiles boxed, tiles
+    // sent to the narrow phase, particle pairs pushed apart.
+    long long self_tests = 0, self_tiles = 0, self_tiles_active = 0, self_contacts = 0;
     long long substeps = 0;         // substeps stepped
     long long slept_substeps = 0;   // substeps skipped because the cloth was asleep
 

@@ -198,23 +198,23 @@ Ray cursor_ray(const AppState& app, const Window& window, float scale) {
 void pins_to_scene(AppState& app) {
     const int cols = app.sim.topology().cols;  // the running cloth, even if an edit of the grid failed to rebuild
     PinSpec& pins = app.scene.pins;
-    std::vector<PinClip> soft;
-    if (pins.clip == ClipHold::Soft) {
+    std::vector<Pin> soft;
+    if (pins.clip == ClipKind::Soft) {
         ClothSettings cloth = app.scene.cloth;
         cloth.rows = app.sim.topology().rows;
         cloth.cols = cols;
         if (pins.preset_radius > 0.0f) {
-            for (std::size_t i : pinned_particles(cloth, PinSpec{pins.preset, {}, 0.0f, ClipHold::Rigid})) {
+            for (std::size_t i : pinned_particles(cloth, PinSpec{pins.preset, {}, 0.0f, ClipKind::Rigid})) {
                 soft.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols, pins.preset_radius});
             }
         }
-        for (const PinClip& p : pins.particles) {
+        for (const Pin& p : pins.particles) {
             if (p.radius > 0.0f) soft.push_back(p);
         }
     }
     app.scene.pins.preset = PinPreset::None;
     app.scene.pins.preset_radius = 0.0f;
-    if (soft.empty()) app.scene.pins.clip = ClipHold::Rigid;  // no clip left to hold softly (validate refuses it)
+    if (soft.empty()) app.scene.pins.clip = ClipKind::Rigid;  // no clip left to hold softly (validate refuses it)
     app.scene.pins.particles = std::move(soft);
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
         if (app.sim.state().pinned[i] == kPinned) {

@@ -162,7 +162,7 @@ const char* bound_source(const StabilityLimit& limit) {
         case StabilityBound::Springs: return "the springs";
         case StabilityBound::Damping: return "the damping (c h < 2)";
         case StabilityBound::Contact: return "penalty contact";
-        case StabilityBound::Clips: return "the soft clips";
+        case StabilityBound::SoftClips: return "the soft clips";
     }
     return "the springs";
 }

@@ -109,7 +109,7 @@ bool pin_combo(const std::string& label, PinSpec* v) {
     const int preset = static_cast<int>(v->preset);
     const auto names = pin_preset_names();
     char clip[48] = "";
-    const char* kind = v->clip == ClipHold::Soft ? "soft clip" : "clip";
+    const char* kind = v->clip == ClipKind::Soft ? "soft clip" : "clip";
     if (v->preset_radius > 0.0f) std::snprintf(clip, sizeof clip, ", %s %.3g m", kind, v->preset_radius);
     const std::string preview = std::string(names[preset]) + clip +
                                 (v->particles.empty() ? "" : " + " + std::to_string(v->particles.size()));
@@ -120,7 +120,7 @@ bool pin_combo(const std::string& label, PinSpec* v) {
                 v->preset = static_cast<PinPreset>(i);
                 v->particles.clear();
                 if (v->preset == PinPreset::None || v->preset_radius == 0.0f) {
-                    v->clip = ClipHold::Rigid;  // no clip left to hold softly
+                    v->clip = ClipKind::Rigid;  // no clip left to hold softly
                 }
                 edited = true;
             }
@@ -129,11 +129,11 @@ bool pin_combo(const std::string& label, PinSpec* v) {
         // Only clips (pins with a radius) can be soft; point pins stay rigid, so without a clip the switch is
         // shown but cannot be used.
         const bool clips = (v->preset != PinPreset::None && v->preset_radius > 0.0f) ||
-                           std::any_of(v->particles.begin(), v->particles.end(), [](const PinClip& p) { return p.radius > 0.0f; });
-        bool soft = v->clip == ClipHold::Soft;
+                           std::any_of(v->particles.begin(), v->particles.end(), [](const Pin& p) { return p.radius > 0.0f; });
+        bool soft = v->clip == ClipKind::Soft;
         ImGui::BeginDisabled(!clips && !soft);
         if (ImGui::Checkbox("soft clips", &soft)) {
-            v->clip = soft ? ClipHold::Soft : ClipHold::Rigid;
+            v->clip = soft ? ClipKind::Soft : ClipKind::Rigid;
             edited = true;
         }
         ImGui::EndDisabled();
@@ -606,7 +606,7 @@ void stability_lines(AppState& app) {
         // The springs are implicit: a plane wave of them sets no limit (stability.hpp).
         ImGui::Text("critical substep %.4g ms (%s)", 1e3 * limit.critical_substep,
                     limit.bound == StabilityBound::Damping ? "damping: c h < 2"
-                    : limit.bound == StabilityBound::Clips ? "soft clips" : "penalty contact");
+                    : limit.bound == StabilityBound::SoftClips ? "soft clips" : "penalty contact");
     } else {
         ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
                     1e3 * limit.plane_wave_substep);

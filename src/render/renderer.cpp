@@ -390,7 +390,7 @@ void Renderer::draw_debug(const RenderInput& input, const glm::mat4& view_projec
         flush(GL_POINTS);
         // A soft clip's particles, held but free to move: orange and smaller.
         lines_.set("u_point_size", 7.0f);
-        for (const Hold& hold : sim.topology().holds) {
+        for (const SoftClipSpring& hold : sim.topology().clip_springs) {
             if (sim.state().pinned[hold.particle] == 0 && hold.particle != input.grabbed) {
                 debug_.push_back({positions[hold.particle], {1.0f, 0.6f, 0.0f, 1.0f}});
             }

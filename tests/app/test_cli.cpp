@@ -254,7 +254,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     CHECK(colliders.at("blocks_tested").at("sphere").get<long long>() <= 30 * 109 * 120);
     CHECK(colliders.at("blocks_tested").at("plane") == 0);  // the cloth is far above the ground
     CHECK_FALSE(colliders.at("blocks_offered").contains("box"));  // no kind the scene does not hold
-    for (const char* skipped : {"wind", "contact", "clips", "tethers", "strain limit", "speed limit"}) {
+    for (const char* skipped : {"wind", "contact", "soft clips", "tethers", "strain limit", "speed limit"}) {
         INFO(skipped);
         CHECK(stage.at(skipped).at("state") == "skipped");
         CHECK(stage.at(skipped).at("ms") == 0.0);
@@ -263,7 +263,7 @@ TEST_CASE("cli: --json reports the step profile: every stage, its time, and why 
     }
     CHECK_THAT(stage.at("wind").at("note").get<std::string>(), Contains("forces.wind"));
     CHECK_THAT(stage.at("contact").at("note").get<std::string>(), Contains("colliders.contact is projection"));
-    CHECK_THAT(stage.at("clips").at("note").get<std::string>(), Contains("no soft clip"));
+    CHECK_THAT(stage.at("soft clips").at("note").get<std::string>(), Contains("no soft clip"));
     double sum = 0.0;
     for (const auto& [name, s] : stage) sum += s.at("ms").get<double>();
     CHECK(p.at("total_ms").get<double>() == Approx(sum));

@@ -173,9 +173,9 @@ TEST_CASE("user session: a soft clip's particles show orange hold markers, not p
     clothsim::Scene scene = clothsim::load_scene("flag");
     clothsim::apply_override(scene, clips);
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
-    REQUIRE(sim.topology().holds.size() > 20);
+    REQUIRE(sim.topology().clip_springs.size() > 20);
     const Image image = paused_flag_start("session_soft_clip_markers", clips);
-    for (const clothsim::Hold& hold : sim.topology().holds) {
+    for (const clothsim::SoftClipSpring& hold : sim.topology().clip_springs) {
         INFO("held " << hold.particle);
         CHECK(orange_near(image, particle_on_screen(scene, hold.particle), 2));
         CHECK_FALSE(red_near(image, particle_on_screen(scene, hold.particle), 1));

@@ -3,8 +3,9 @@
 #include "every_kernel.hpp"
 #include "support.hpp"
 
-#include "clothsim/broad_phase.hpp"
-#include "clothsim/colliders.hpp"
+#include "simulation/mass_spring_internals.hpp"
+#include "collision/broad_phase.hpp"
+#include "collision/colliders.hpp"
 #include "clothsim/scene.hpp"
 
 #include <catch2/catch.hpp>
@@ -370,7 +371,7 @@ TEST_CASE("broad_phase the carried box holds every particle, and the blocks hold
                 fast.substep();
                 every.substep();
                 const State& st = fast.state();
-                const CollisionBlocks& blocks = fast.collision_blocks();
+                const CollisionBlocks& blocks = collision_blocks(fast);
                 REQUIRE(blocks.boxes_current);
                 if (blocks.carried_valid) {  // every particle and the start of its path (x - motion)
                     for (std::size_t i = 0; i < st.size(); ++i) {
@@ -412,8 +413,8 @@ TEST_CASE("broad_phase a cloth moved into the sphere between steps is pushed out
         MassSpring sim = build_simulation(hanging_over_sphere(1, broad_phase, 0.0f));
         sim.run_steps(3);  // the carried box is still far above the sphere
         if (broad_phase) {
-            REQUIRE(sim.collision_blocks().bounds == BlockBounds::Lowest);
-            REQUIRE(sim.collision_blocks().carried_lo.y > 1.0);
+            REQUIRE(collision_blocks(sim).bounds == BlockBounds::Lowest);
+            REQUIRE(collision_blocks(sim).carried_lo.y > 1.0);
         }
         const SphereCollider& sphere = test::sphere(sim.settings().colliders);
         const glm::dvec3 centre(sphere.center);
@@ -443,7 +444,7 @@ TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has mo
         INFO("broad phase " << broad_phase);
         MassSpring sim = build_simulation(hanging_over_sphere(1, broad_phase, 0.0f));
         sim.run_steps(3);
-        if (broad_phase) REQUIRE(sim.collision_blocks().bounds == BlockBounds::Lowest);
+        if (broad_phase) REQUIRE(collision_blocks(sim).bounds == BlockBounds::Lowest);
         test::edit_settings(sim, [](SimulationSettings& s) { test::collider(s.colliders, "sphere").enabled = false; });
         sim.run_steps(25);
         const glm::vec3 middle(sim.state().position.get(40 * 20 + 20));

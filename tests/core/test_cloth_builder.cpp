@@ -224,8 +224,8 @@ TEST_CASE("apply_fabric: on every bundled scene, the masses and constants of a c
             CHECK(std::equal(sim.state().inverse_mass.begin(), sim.state().inverse_mass.end(),
                              built.state().inverse_mass.begin(), built.state().inverse_mass.end()));
             CHECK(sim.settings().springs == built.settings().springs);
-            for (std::size_t h = 0; h < sim.topology().holds.size(); ++h) {  // soft clips follow the stiffness
-                CHECK(sim.topology().holds[h].stiffness == built.topology().holds[h].stiffness);
+            for (std::size_t h = 0; h < sim.topology().clip_springs.size(); ++h) {  // soft clips follow the stiffness
+                CHECK(sim.topology().clip_springs[h].stiffness == built.topology().clip_springs[h].stiffness);
             }
             // As the app's auto substeps does: a stiffer fabric needs shorter substeps.
             sim.set_substeps(auto_substeps(stability_limit(sim), sim.settings().integration.dt, 0.5f,

@@ -1,5 +1,5 @@
 // cloth.shape: a disc keeps the particles inside the grid's inscribed circle, on every solver path.
-#include "clothsim/cloth_shape.hpp"
+#include "scene/cloth_shape.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 

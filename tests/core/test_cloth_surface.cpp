@@ -5,7 +5,7 @@
 #include "clothsim/cloth_surface.hpp"
 #include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
-#include "clothsim/tearing.hpp"
+#include "model/tearing.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>

@@ -3,7 +3,7 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -443,7 +443,10 @@ TEST_CASE("colliders friction on the cylinder's top face slows sliding at mu g a
 
 TEST_CASE("colliders a cloth drapes over the cylinder: none inside, on the top face and down the side",
           "[colliders]") {
-    for (const char* integrator : {"verlet", "implicit-euler"}) {
+    // Under the sanitizers Verlet alone (implicit Euler's contact with the cylinder takes 90 s there; its
+    // solver meets the colliders under them in "implicit Euler, XPBD and projective at dt 0.1 ...").
+    for (const char* integrator : test::kSanitized ? std::vector<const char*>{"verlet"}
+                                                  : std::vector<const char*>{"verlet", "implicit-euler"}) {
         INFO(integrator);
         Scene scene = drape_on_cylinder();
         apply_override(scene, std::string("integration.integrator=") + integrator);

@@ -5,7 +5,7 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -206,9 +206,9 @@ TEST_CASE("fast solver is only used for grid topologies; others run the textbook
     CHECK(sim.position(1).x == 1.0f);
 }
 
-TEST_CASE("fast solver steps every row block when OpenMP gives fewer threads than blocks", "[fast_solver]") {
+TEST_CASE("fast solver steps every band when OpenMP gives fewer threads than bands", "[fast_solver]") {
     // Inside an active parallel region (nested parallelism off by default) the solver's own region gets a
-    // team of one thread: every block must still be stepped, and bit-identically.
+    // team of one thread: every band must still be stepped, and bit-identically.
     Scene scene = per_spring_scene("hanging");  // 64 x 32 at the scene's substeps: stable per spring
     scene.cloth.rows = 64;
     const MassSpring one = run(scene, SolverMethod::Fast, 1, 100);

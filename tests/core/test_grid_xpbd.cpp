@@ -19,22 +19,22 @@ using namespace clothsim;
 namespace {
 
 // The grid form's projection order (grid_xpbd.hpp) as a sort key of an element from particle a to b: its
-// direction; for the directions down, whether it reaches from its block of rows into the next, and its block;
+// direction; for the directions down, whether it reaches from its band of rows into the next, and its band;
 // then its row, its phase along the row, its column.
 std::tuple<int, int, int, int, int, int> spring_key(const Topology& t, std::uint32_t a, std::uint32_t b) {
     int ra = static_cast<int>(a) / t.cols, ca = static_cast<int>(a) % t.cols;
     int rb = static_cast<int>(b) / t.cols, cb = static_cast<int>(b) % t.cols;
     if (rb < ra || (rb == ra && cb < ca)) std::swap(ra, rb), std::swap(ca, cb);
     const int dr = rb - ra, dc = cb - ca;
-    constexpr int block_rows = GridXpbd::kBlockRows;
-    const int block = ra / block_rows;
-    const int reaches = rb >= (block + 1) * block_rows ? 1 : 0;  // into the next block
-    if (dr == 0 && dc == 1) return {0, 0, block, ra, ca % 2, ca};  // along the row, every second column
-    if (dr == 1 && dc == 0) return {1, reaches, block, ra, 0, ca};  // down
-    if (dr == 1 && dc == 1) return {2, reaches, block, ra, 0, ca};  // diagonal down right
-    if (dr == 1 && dc == -1) return {3, reaches, block, ra, 0, ca}; // diagonal down left
-    if (dr == 0 && dc == 2) return {4, 0, block, ra, ca % 3, ca};  // two apart along the row, every third column
-    return {5, reaches, block, ra, 0, ca};                          // two apart down
+    constexpr int band_rows = GridXpbd::kBandRows;
+    const int band = ra / band_rows;
+    const int reaches = rb >= (band + 1) * band_rows ? 1 : 0;  // into the next band
+    if (dr == 0 && dc == 1) return {0, 0, band, ra, ca % 2, ca};  // along the row, every second column
+    if (dr == 1 && dc == 0) return {1, reaches, band, ra, 0, ca};  // down
+    if (dr == 1 && dc == 1) return {2, reaches, band, ra, 0, ca};  // diagonal down right
+    if (dr == 1 && dc == -1) return {3, reaches, band, ra, 0, ca}; // diagonal down left
+    if (dr == 0 && dc == 2) return {4, 0, band, ra, ca % 3, ca};  // two apart along the row, every third column
+    return {5, reaches, band, ra, 0, ca};                          // two apart down
 }
 
 // `sim`'s topology with its springs and bends listed in the grid form's order.
@@ -95,9 +95,9 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         {"per-spring drape-sphere", xpbd_scene(per_spring_scene("drape-sphere"), 10, 17, 4)},
         {"material hanging", xpbd_scene(material, 12, 19, 8)},
         {"material disc", xpbd_scene(disc, 15, 15, 8)},
-        // Three blocks of rows and a part of one: the rows that reach into the next block come last.
-        {"per-spring hanging, tall", xpbd_scene(per_spring_scene("hanging"), 2 * GridXpbd::kBlockRows + 9, 9, 8)},
-        {"material hanging, tall", xpbd_scene(material, 3 * GridXpbd::kBlockRows + 1, 10, 8)},
+        // Three bands of rows and a part of one: the rows that reach into the next band come last.
+        {"per-spring hanging, tall", xpbd_scene(per_spring_scene("hanging"), 2 * GridXpbd::kBandRows + 9, 9, 8)},
+        {"material hanging, tall", xpbd_scene(material, 3 * GridXpbd::kBandRows + 1, 10, 8)},
         // The bundled scene that runs XPBD, on the grid of the simulation loops (support.hpp).
         {"stiff-drape", test::scene_for_loops("stiff-drape")},
     };

@@ -4,7 +4,7 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>

@@ -395,7 +395,7 @@ TEST_CASE("scene file: a valid file from disk loads") {
     CHECK(s.cloth.rows == 3);
     CHECK(s.cloth.cols == 2);
     CHECK(s.pins.preset == clothsim::PinPreset::TopRow);
-    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{2, 1}});
+    CHECK(s.pins.particles == std::vector<clothsim::Pin>{{2, 1}});
     CHECK(s.cloth.size == glm::vec2(0.5f, 0.5f));
     CHECK(clothsim::test::collider(s.settings.colliders, "sphere").enabled);
     CHECK(clothsim::test::sphere(s.settings.colliders).radius == 0.25f);
@@ -464,10 +464,10 @@ TEST_CASE("scene override: ints, floats, vectors, booleans, strings and bare wor
     CHECK(s.pins.preset == clothsim::PinPreset::FourCorners);
     clothsim::apply_override(s, "pins=[[0,0],[7,5]]");
     CHECK(s.pins.preset == clothsim::PinPreset::None);
-    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{0, 0}, {7, 5}});
+    CHECK(s.pins.particles == std::vector<clothsim::Pin>{{0, 0}, {7, 5}});
     clothsim::apply_override(s, "pins={ preset = \"left-edge\", particles = [[3, 3]] }");
     CHECK(s.pins.preset == clothsim::PinPreset::LeftEdge);
-    CHECK(s.pins.particles == std::vector<clothsim::PinClip>{{3, 3}});
+    CHECK(s.pins.particles == std::vector<clothsim::Pin>{{3, 3}});
 
     clothsim::apply_override(s, "forces.wind_model=uniform");
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Uniform);
@@ -704,7 +704,7 @@ TEST_CASE("scene pins: pinned_particles of every preset on a 4 x 5 grid") {
 }
 
 TEST_CASE("scene pins: clips are read from a pins list, a pins table and --set") {
-    using Clips = std::vector<clothsim::PinClip>;
+    using Clips = std::vector<clothsim::Pin>;
     const clothsim::Scene preset =
         clothsim::parse_scene("pins = { preset = \"top-corners\", radius = 0.02 }\n", "t.toml");
     CHECK(preset.pins.preset == clothsim::PinPreset::TopCorners);
@@ -734,15 +734,15 @@ TEST_CASE("scene pins: clips are read from a pins list, a pins table and --set")
     CHECK(s.pins == clothsim::PinSpec{});
 
     // How clips hold: rigid unless the table says soft.
-    CHECK(preset.pins.clip == clothsim::ClipHold::Rigid);
+    CHECK(preset.pins.clip == clothsim::ClipKind::Rigid);
     const clothsim::Scene soft =
         clothsim::parse_scene("pins = { preset = \"top-corners\", radius = 0.15, clip = \"soft\" }\n", "t.toml");
-    CHECK(soft.pins.clip == clothsim::ClipHold::Soft);
+    CHECK(soft.pins.clip == clothsim::ClipKind::Soft);
     CHECK(soft.pins.preset_radius == 0.15f);
     clothsim::apply_override(s, "pins={ preset = \"top-row\", radius = 0.01, clip = \"soft\" }");
-    CHECK(s.pins.clip == clothsim::ClipHold::Soft);
+    CHECK(s.pins.clip == clothsim::ClipKind::Soft);
     clothsim::apply_override(s, "pins={ preset = \"top-row\", radius = 0.01, clip = \"rigid\" }");
-    CHECK(s.pins.clip == clothsim::ClipHold::Rigid);
+    CHECK(s.pins.clip == clothsim::ClipKind::Rigid);
 }
 
 TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [row, col]") {
@@ -762,8 +762,8 @@ TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [ro
          {clothsim::PinSpec{clothsim::PinPreset::FourCorners, {}, 0.125f},
           clothsim::PinSpec{clothsim::PinPreset::None, {{1, 1, 1.0f}, {0, 4, 1e-7f}}},
           clothsim::PinSpec{clothsim::PinPreset::LeftEdge, {{3, 0, 0.1f / 3.0f}}, 0.7f},
-          clothsim::PinSpec{clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipHold::Soft},
-          clothsim::PinSpec{clothsim::PinPreset::None, {{2, 3, 0.05f}}, 0.0f, clothsim::ClipHold::Soft}}) {
+          clothsim::PinSpec{clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipKind::Soft},
+          clothsim::PinSpec{clothsim::PinPreset::None, {{2, 3, 0.05f}}, 0.0f, clothsim::ClipKind::Soft}}) {
         s.pins = pins;
         const std::string written = clothsim::to_toml(s);
         INFO(written);
@@ -776,7 +776,7 @@ TEST_CASE("scene pins: clips round-trip through to_toml, radius 0 as a plain [ro
     CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "\"top-row\"");
     s.pins = {clothsim::PinPreset::None, {{1, 1}}};
     CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) == "{ preset = \"none\", particles = [[1, 1]] }");
-    s.pins = {clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipHold::Soft};
+    s.pins = {clothsim::PinPreset::TopCorners, {}, 0.15f, clothsim::ClipKind::Soft};
     CHECK(clothsim::format_value(s, *clothsim::find_field("pins")) ==
           "{ preset = \"top-corners\", radius = 0.15, clip = \"soft\" }");
 }

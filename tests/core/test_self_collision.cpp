@@ -4,8 +4,8 @@
 
 #include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
-#include "clothsim/self_collision.hpp"
-#include "clothsim/tearing.hpp"
+#include "collision/self_collision.hpp"
+#include "model/tearing.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>

@@ -3,7 +3,7 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/step_plan.hpp"
 

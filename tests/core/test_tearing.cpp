@@ -3,7 +3,7 @@
 
 #include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
-#include "clothsim/tearing.hpp"
+#include "model/tearing.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>

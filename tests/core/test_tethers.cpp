@@ -2,11 +2,12 @@
 #include "every_kernel.hpp"
 #include "support.hpp"
 
-#include "clothsim/broad_phase.hpp"
-#include "clothsim/colliders.hpp"
+#include "simulation/mass_spring_internals.hpp"
+#include "collision/broad_phase.hpp"
+#include "collision/colliders.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/strain.hpp"
-#include "clothsim/tethers.hpp"
+#include "model/tethers.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -110,9 +111,9 @@ TEST_CASE("tethers: a cloth hanging from two point pins never stretches past tet
     CHECK(tied.all_finite());
 }
 
-TEST_CASE("tethers: on the fast solver's row blocks and threads the cloth is the textbook solver's bit for bit, its "
+TEST_CASE("tethers: on the fast solver's bands and threads the cloth is the textbook solver's bit for bit, its "
           "hem lying on the ground, every kernel and thread count", "[tethers][fast_solver]") {
-    // The fast path projects each row block's tethers and boxes its collision blocks again on the thread that
+    // The fast path projects each band's tethers and boxes its collision blocks again on the thread that
     // swept the block (MassSpring::apply_tethers, box_blocks_on_team); the textbook path in one pass. A box
     // that missed a particle the tethers moved would leave it in the ground.
     test::with_every_kernel([] {
@@ -163,7 +164,7 @@ TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep
                 for (int substep = 0; substep < 300; ++substep) {
                     fast.substep();
                     limited_substeps += fast.tethers_at_limit() > 0;
-                    const CollisionBlocks& blocks = fast.collision_blocks();
+                    const CollisionBlocks& blocks = collision_blocks(fast);
                     REQUIRE(blocks.boxes_current);
                     // With the sphere the stage sweeps each box by the cloth's largest motion (colliders.cpp).
                     const Box motion = particle_bounds(fast.state().motion, 0, fast.state().size());
@@ -226,7 +227,7 @@ TEST_CASE("tethers: a tethered pendulum released level swings down with the spee
         s.cloth.size = {1.0f, 1.0f};
         s.cloth.mass = 2.0f;
         s.cloth.origin = {0.0f, 0.0f, 0.0f};
-        s.pins = PinSpec{PinPreset::None, {PinClip{0, 0, 0.0f}}, 0.0f};
+        s.pins = PinSpec{PinPreset::None, {Pin{0, 0, 0.0f}}, 0.0f};
         s.settings.springs = {glm::vec2(0.0f), 0.0f, glm::vec2(0.0f), 0.0f};
         s.settings.springs.tether_strain = 0.01f;
         test::collider(s.settings.colliders, "ground").enabled = false;

@@ -1,6 +1,6 @@
 #include "clothsim/reference.hpp"
 
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 #include "clothsim/scene.hpp"
 #include "model/forces.hpp"
 #include "integrators/integrators.hpp"
@@ -40,7 +40,7 @@ std::vector<glm::dvec3> run_double_rk4(const Scene& scene, double duration, doub
             external.resize(s.size());
             if (plan.wind) accumulate_wind_forces(topology, s, settings.forces, rest_area, external);
             if (plan.contact) accumulate_contact_forces(s, settings.colliders, external);
-            if (plan.holds) accumulate_hold_forces(topology, s.position, external);
+            if (plan.soft_clips) accumulate_soft_clip_forces(topology, s.position, external);
             for (std::size_t i = 0; i < s.size(); ++i) out.add(i, external.get(i));
         }
     };

@@ -62,20 +62,20 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     // contact does. Every integrator but projective takes it explicitly, like contact; projective has it in its
     // matrix (projective.hpp).
     double hold_rate = 0.0;  // the largest k / m of a hold (1/s^2)
-    for (const Hold& h : topology.holds) {
+    for (const SoftClipSpring& h : topology.clip_springs) {
         if (!state.pinned[h.particle]) hold_rate = std::max(hold_rate, double(h.stiffness) / state.mass[h.particle]);
     }
     const double hold_substep = hold_rate > 0.0 ? critical(std::sqrt(hold_rate), c, 2.0, DampingForm::None)
                                                 : std::numeric_limits<double>::infinity();
     const double explicit_substep = std::min(contact_substep, hold_substep);
-    const StabilityBound explicit_bound = hold_substep < contact_substep ? StabilityBound::Clips : StabilityBound::Contact;
+    const StabilityBound explicit_bound = hold_substep < contact_substep ? StabilityBound::SoftClips : StabilityBound::Contact;
     // The integrator's row (integrator.hpp) says how its springs, damping and soft clips bound the substep.
     const IntegratorInfo& info = integrator_info(integrator);
     if (info.implicit_springs) {
         // Springs implicit: contact (and soft clips, unless they are in the solver's matrix) are taken
         // explicitly, and an explicit damping term is stable while c h < its limit.
-        double substep = info.holds_implicit ? contact_substep : explicit_substep;
-        StabilityBound bound = info.holds_implicit ? StabilityBound::Contact : explicit_bound;
+        double substep = info.soft_clips_implicit ? contact_substep : explicit_substep;
+        StabilityBound bound = info.soft_clips_implicit ? StabilityBound::Contact : explicit_bound;
         if (info.damping_limit > 0.0) {
             const double damping_substep = c > 0.0 ? info.damping_limit / c : std::numeric_limits<double>::infinity();
             if (damping_substep <= substep) bound = StabilityBound::Damping;
@@ -100,7 +100,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         row_sum[b.m] += 8.0 * k;
         row_sum[b.b] += 4.0 * k;
     }
-    for (const Hold& h : topology.holds) row_sum[h.particle] += h.stiffness;
+    for (const SoftClipSpring& h : topology.clip_springs) row_sum[h.particle] += h.stiffness;
     double gershgorin = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
@@ -207,7 +207,7 @@ std::string what_bounds(const MassSpring& sim) {
                       kind, stiffest, needed, limit.critical_substep);
     } else {
         std::snprintf(text, sizeof text, "; the %s need %.0f substeps per step (substep %.3g s)",
-                      limit.bound == StabilityBound::Damping ? "damping" : limit.bound == StabilityBound::Clips ? "soft clips" : "penalty contact",
+                      limit.bound == StabilityBound::Damping ? "damping" : limit.bound == StabilityBound::SoftClips ? "soft clips" : "penalty contact",
                       needed, limit.critical_substep);
     }
     return text;

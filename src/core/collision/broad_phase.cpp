@@ -1,4 +1,4 @@
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 
 #include "integrators/fast_solver.hpp"
 

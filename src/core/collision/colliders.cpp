@@ -1,4 +1,4 @@
-#include "clothsim/colliders.hpp"
+#include "collision/colliders.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>

@@ -1,4 +1,4 @@
-#include "clothsim/self_collision.hpp"
+#include "collision/self_collision.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -1,6 +1,6 @@
 #include "integrators/fast_solver.hpp"
 
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "integrators/verlet.hpp"
 
 #include <immintrin.h>
@@ -294,8 +294,8 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) void bend_forces_avx512(con
     }
 }
 
-// The running bounds of a block's motion in eight lanes per component (lane j: columns j, j + 8, ...), so a
-// row widens them with whole vectors and no reduction; the lanes are reduced once, at the end of the block.
+// The running bounds of a band's motion in eight lanes per component (lane j: columns j, j + 8, ...), so a
+// row widens them with whole vectors and no reduction; the lanes are reduced once, at the end of the band.
 // Layout (FastSolver::Scratch::motion_lanes): lo of component k at [8 k, 8 k + 8), hi at [24 + 8 k, ...).
 void reset_lanes(double* lanes) {
     std::fill(lanes, lanes + 24, INFINITY);
@@ -457,19 +457,19 @@ int FastSolver::effective_threads(int requested) const {
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
                       double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
-    const int blocks = effective_threads(settings.solver.threads);
+    const int bands = effective_threads(settings.solver.threads);
     const std::size_t row_floats = 18 * spring_row_stride(cols_);
-    // Buffers and the block layout are set up again only when the block count changes.
-    if (blocks != blocks_) {
-        blocks_ = blocks;
-        scratch_.resize(blocks);
+    // Buffers and the band layout are set up again only when the band count changes.
+    if (bands != bands_) {
+        bands_ = bands;
+        scratch_.resize(bands);
         for (Scratch& s : scratch_) s.window.assign(3 * row_floats, 0.0f);
         zeros_.assign(row_floats, 0.0f);
         boundary_slot_.assign(rows_, -1);
         no_boundary_.assign(rows_, -1);
-        boundary_.assign(static_cast<std::size_t>(2 * blocks) * row_floats, 0.0f);
-        for (int b = 1; b < blocks; ++b) {
-            const int begin = block_begin(b, blocks);
+        boundary_.assign(static_cast<std::size_t>(2 * bands) * row_floats, 0.0f);
+        for (int b = 1; b < bands; ++b) {
+            const int begin = band_begin(b, bands);
             boundary_slot_[begin - 2] = 2 * b;
             boundary_slot_[begin - 1] = 2 * b + 1;
         }
@@ -479,8 +479,8 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
                                        bounds, motion_bounds != nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
-    const bool automatic = settings.solver.threads == 0 && blocks > 1;
-    const bool single = blocks == 1 || (automatic && team_.next_is_single());
+    const bool automatic = settings.solver.threads == 0 && bands > 1;
+    const bool single = bands == 1 || (automatic && team_.next_is_single());
     if (motion_bounds) *motion_bounds = MotionBounds{};
     if (single) {
         const auto start = std::chrono::steady_clock::now();
@@ -488,52 +488,52 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         if (automatic) team_.record(true, std::chrono::steady_clock::now() - start);
         if (motion_bounds) *motion_bounds = reduce_lanes(scratch_[0].motion_lanes.data());
         state.substep = h;
-        last_blocks_ = 1;
+        last_bands_ = 1;
         return;
     }
     const auto start = std::chrono::steady_clock::now();
-#pragma omp parallel num_threads(blocks)
+#pragma omp parallel num_threads(bands)
     {
         // OpenMP may give fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, nesting): every thread
-        // takes every team-size-th block, so no block is ever skipped and each is computed the same way.
+        // takes every team-size-th band, so no band is ever skipped and each is computed the same way.
         const int team = omp_get_num_threads();
-        // Phase 1: the two spring rows above the next block read that block's first rows, which its thread
+        // Phase 1: the two spring rows above the next band read that band's first rows, which its thread
         // will overwrite; compute them while every position is still the old one.
-        for (int b = omp_get_thread_num(); b + 1 < blocks; b += team) {
-            const int next = block_begin(b + 1, blocks);
+        for (int b = omp_get_thread_num(); b + 1 < bands; b += team) {
+            const int next = band_begin(b + 1, bands);
             for (int r : {next - 2, next - 1}) {
                 spring_row(state, settings.springs, spring_mask, r,
                            boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
             }
         }
 #pragma omp barrier
-        for (int b = omp_get_thread_num(); b < blocks; b += team) {
-            sweep(state, sweep_settings, block_begin(b, blocks), block_begin(b + 1, blocks), scratch_[b],
+        for (int b = omp_get_thread_num(); b < bands; b += team) {
+            sweep(state, sweep_settings, band_begin(b, bands), band_begin(b + 1, bands), scratch_[b],
                   boundary_slot_);
         }
     }
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
-    last_blocks_ = blocks;
-    for (int b = 0; motion_bounds && b < blocks; ++b) {
-        if (block_begin(b, blocks) < block_begin(b + 1, blocks)) {
+    last_bands_ = bands;
+    for (int b = 0; motion_bounds && b < bands; ++b) {
+        if (band_begin(b, bands) < band_begin(b + 1, bands)) {
             motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
         }
     }
     state.substep = h;
 }
 
-void FastSolver::for_each_block(const std::function<void(int, int, int)>& work) const {
-    const int blocks = last_blocks_;
-    if (blocks <= 1) {
+void FastSolver::for_each_band(const std::function<void(int, int, int)>& work) const {
+    const int bands = last_bands_;
+    if (bands <= 1) {
         work(0, 0, rows_);
         return;
     }
-#pragma omp parallel num_threads(blocks)
+#pragma omp parallel num_threads(bands)
     {
-        // As in step(): every thread takes every team-size-th block, so block b runs on the thread that swept it.
+        // As in step(): every thread takes every team-size-th band, so band b runs on the thread that swept it.
         const int team = omp_get_num_threads();
-        for (int b = omp_get_thread_num(); b < blocks; b += team) {
-            work(b, block_begin(b, blocks), block_begin(b + 1, blocks));
+        for (int b = omp_get_thread_num(); b < bands; b += team) {
+            work(b, band_begin(b, bands), band_begin(b + 1, bands));
         }
     }
 }
@@ -674,7 +674,7 @@ struct RowData {
 // the motion and the position double, as in integrate_verlet. A pinned particle (inverse mass 0) has no
 // change and zero motion, so it does not move. Every particle is read and written once.
 //
-// With `lanes` (the block's running bounds of the motion, reset_lanes' layout) the row's new motions widen
+// With `lanes` (the band's running bounds of the motion, reset_lanes' layout) the row's new motions widen
 // them while they are still in registers, in whole vectors: column c goes to lane c mod 8, as widen_tail
 // takes it, and the bounds are exact (a minimum and a maximum round nothing). The columns after the last
 // whole vector widen them in a second pass (widen_tail).
@@ -765,7 +765,7 @@ template <FastKernel K, unsigned Mask, bool Ext>
     }
 }
 
-// Everything the sweep of one row block reads besides the state.
+// Everything the sweep of one band reads besides the state.
 struct SweepInput {
     const Grid& grid;
     const AlignedVector<float>& boundary;
@@ -777,7 +777,7 @@ struct SweepInput {
     BlockBounds bounds;  // what of each box
     float* window;
     const float* zeros;
-    double* motion_lanes;  // the running bounds of the block's motion (8 lanes), or null when not asked for
+    double* motion_lanes;  // the running bounds of the band's motion (8 lanes), or null when not asked for
 };
 
 template <FastKernel K, unsigned Mask>

@@ -18,13 +18,13 @@
 //  - The state is double (state.hpp): the spring kernels take each difference in double and round it to
 //    float, the row update adds a float change to the double motion. Every particle's data is read and
 //    written once. AVX-512 (when the CPU has it) does the differences and the update 8 doubles at a time.
-//  - Threads take contiguous blocks of rows. The only springs that read across a block boundary are the
+//  - Threads take contiguous bands of rows. The only springs that read across a band boundary are the
 //    two spring rows just above it; they are computed before a barrier into shared storage and both
 //    neighbouring threads use the stored values. Each particle's force is summed in the same order for
 //    any partition, so the result is bit-identical for any thread count.
 #pragma once
 
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 #include "integrators/team_choice.hpp"
@@ -55,16 +55,16 @@ public:
               double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
               BlockBounds bounds = BlockBounds::Box);
 
-    // Threads the solver will really use for `requested` (0 = one per core): rows are split into blocks of
+    // Threads the solver will really use for `requested` (0 = one per core): rows are split into bands of
     // at least 8.
     int effective_threads(int requested) const;
     // With threads = 0: whether the last substeps ran on one thread because the team was slower.
     bool team_set_aside() const { return team_.single(); }
-    // Runs work(block, row_begin, row_end) over all rows, split as the last substep's sweep split them, each
-    // block on the thread that swept it (all rows on this thread when the last substep ran on one): a stage
-    // that touches each particle on its own (the tethers, the collision boxes) then finds each block in the
+    // Runs work(band, row_begin, row_end) over all rows, split as the last substep's sweep split them, each
+    // band on the thread that swept it (all rows on this thread when the last substep ran on one): a stage
+    // that touches each particle on its own (the tethers, the collision boxes) then finds each band in the
     // caches of the core that has just written it. Blocks are numbered from 0, at most 64 of them.
-    void for_each_block(const std::function<void(int, int, int)>& work) const;
+    void for_each_band(const std::function<void(int, int, int)>& work) const;
     // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
     static FastKernel best_kernel();
     static FastKernel kernel();
@@ -78,7 +78,7 @@ private:
 
     struct Scratch {
         AlignedVector<float> window;  // the last three spring rows (6 directions x 3 components, padded)
-        // The running bounds of the motion of the rows this block's sweep updated, when asked for: 8 lanes of
+        // The running bounds of the motion of the rows this band's sweep updated, when asked for: 8 lanes of
         // lo and of hi per component (fast_solver.cpp).
         alignas(64) std::array<double, 48> motion_lanes{};
     };
@@ -91,8 +91,8 @@ private:
         BlockBounds bounds;
         bool motion_bounds;
     };
-    // The first row of block b of `blocks`: rows are split as evenly as whole rows allow.
-    int block_begin(int b, int blocks) const { return static_cast<int>(static_cast<long long>(rows_) * b / blocks); }
+    // The first row of band b of `bands`: rows are split as evenly as whole rows allow.
+    int band_begin(int b, int bands) const { return static_cast<int>(static_cast<long long>(rows_) * b / bands); }
     void sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                const std::vector<int>& boundary_slot);
     // Forces of the springs of the kinds in `mask` starting in row r, into out[d][component][c] (6 x 3 x cols).
@@ -107,14 +107,14 @@ private:
     // fix_begin_[d][r + 1]).
     std::array<std::vector<int>, 6> fix_begin_;
     std::array<std::vector<std::pair<int, float>>, 6> fixes_;
-    int blocks_ = 0;                           // the row-block count the buffers below are laid out for
+    int bands_ = 0;                           // the band count the buffers below are laid out for
     std::vector<Scratch> scratch_;             // one per thread
-    AlignedVector<float> boundary_;            // spring rows just above block boundaries
+    AlignedVector<float> boundary_;            // spring rows just above band boundaries
     AlignedVector<float> zeros_;               // a spring row of zeros: the rows above row 0
     std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
-    std::vector<int> no_boundary_;             // all -1: one block sweeping every row
+    std::vector<int> no_boundary_;             // all -1: one band sweeping every row
     TeamChoice team_;                          // solver.threads = 0: the team, or one thread when it is faster
-    int last_blocks_ = 1;                      // the row blocks of the last substep (1: it ran on one thread)
+    int last_bands_ = 1;                      // the bands of the last substep (1: it ran on one thread)
 };
 
 }  // namespace clothsim

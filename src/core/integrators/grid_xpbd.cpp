@@ -358,9 +358,9 @@ void GridXpbd::set_substep(double h) {
 }
 
 int GridXpbd::effective_threads(int requested) const {
-    const int blocks = (rows_ + kBlockRows - 1) / kBlockRows;
+    const int bands = (rows_ + kBandRows - 1) / kBandRows;
     const int wanted = requested > 0 ? requested : omp_get_num_procs();
-    return std::max(1, std::min(wanted, blocks));
+    return std::max(1, std::min(wanted, bands));
 }
 
 void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int threads) {
@@ -389,7 +389,7 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     Kernel kernel = project_generic;
     if (FastSolver::kernel() == FastKernel::Avx2) kernel = project_avx2;
     if (FastSolver::kernel() == FastKernel::Avx512) kernel = project_avx512;
-    const int rows = rows_, blocks = (rows_ + kBlockRows - 1) / kBlockRows;
+    const int rows = rows_, bands = (rows_ + kBandRows - 1) / kBandRows;
     const double h2 = h * h, inv_h = 1.0 / h, damping = dynamics.damping;
     const glm::dvec3 g(dynamics.gravity);
     double violation2 = 0.0;
@@ -429,17 +429,17 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
                 for (int row = 0; row < rows; ++row) violation += kernel(pass, stage, row, row + 1);
                 continue;
             }
-            // Down: each block of rows from its top, all at once; then the rows whose elements reach into the
-            // next block, each block's from its top (the order does not depend on the thread count).
+            // Down: each band of rows from its top, all at once; then the rows whose elements reach into the
+            // next band, each band's from its top (the order does not depend on the thread count).
             const int span = stage == Stage::DownSkipOne || stage == Stage::DownBends ? 2 : 1;
 #pragma omp for schedule(static)
-            for (int b = 0; b < blocks; ++b) {
-                const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
+            for (int b = 0; b < bands; ++b) {
+                const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
                 violation += kernel(pass, stage, first, last - span);  // none reaches past `last`
             }
 #pragma omp for schedule(static)
-            for (int b = 0; b < blocks; ++b) {
-                const int first = b * kBlockRows, last = std::min(rows, first + kBlockRows);
+            for (int b = 0; b < bands; ++b) {
+                const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
                 violation += kernel(pass, stage, std::max(first, last - span), std::min(last, rows - span));
             }
         }

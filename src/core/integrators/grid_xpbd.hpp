@@ -42,13 +42,13 @@ public:
     void set_stiffness(const Topology& topology, const SpringSettings& springs);
 
     // One substep: predict with the external accelerations (gravity, wind, damping), project every element
-    // once, motion = x' - x. As step_xpbd. `threads` (0: one per core) share the blocks of rows; the result is
+    // once, motion = x' - x. As step_xpbd. `threads` (0: one per core) share the bands of rows; the result is
     // the same for any thread count.
     void step(State& state, const Dynamics& dynamics, double h, int threads);
-    // The threads `requested` really gives: at most one per block of kBlockRows rows.
+    // The threads `requested` really gives: at most one per band of kBandRows rows.
     int effective_threads(int requested) const;
 
-    static constexpr int kBlockRows = 32;
+    static constexpr int kBandRows = 32;
 
     // |C(x) + alpha~ lambda| / |C(prediction)| at `position`, as xpbd_residual (0 before a substep).
     double residual(const DVec3Array& position) const;

@@ -130,7 +130,7 @@ std::shared_ptr<const ProjectiveSolver::Factor> factorise(const State& state, co
     }
     // A soft clip's hold, 0.5 k |x - anchor|^2, adds k on its particle's diagonal (and k anchor to the
     // right-hand side): quadratic, so A holds it exactly and the step takes it implicitly.
-    for (const Hold& hold : topology.holds) add(hold.particle, hold.particle, hold.stiffness);
+    for (const SoftClipSpring& hold : topology.clip_springs) add(hold.particle, hold.particle, hold.stiffness);
     // A bend's energy 0.5 k |x_a - 2 x_m + x_b|^2 adds k b b^T with b = (1, -2, 1) on (a, m, b).
     for (const Bend& b : topology.bends) {
         const double k = stiffness_of(springs, b);
@@ -197,7 +197,7 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
         DVec3Array force;
         force.resize(n);
         accumulate_spring_forces(topology, state.position, springs, force);
-        accumulate_hold_forces(topology, state.position, force);
+        accumulate_soft_clip_forces(topology, state.position, force);
         previous_position_ = state.position;
         previous_velocity_.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
@@ -239,7 +239,7 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
         const glm::dvec3 p = state.position.get(e.pinned);
         constant.row(e.row) -= e.value * Eigen::RowVector3d(p.x, p.y, p.z);
     }
-    for (const Hold& hold : topology.holds) {
+    for (const SoftClipSpring& hold : topology.clip_springs) {
         const int r = f.free_index[hold.particle];
         if (r >= 0) constant.row(r) += double(hold.stiffness) * Eigen::RowVector3d(hold.anchor.x, hold.anchor.y, hold.anchor.z);
     }
@@ -273,7 +273,7 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
             const glm::dvec3 d = bend_difference(position, b);
             e += 0.5 * double(stiffness_of(springs, b)) * glm::dot(d, d);
         }
-        for (const Hold& hold : topology.holds) {
+        for (const SoftClipSpring& hold : topology.clip_springs) {
             const glm::dvec3 d = position.get(hold.particle) - hold.anchor;
             e += 0.5 * double(hold.stiffness) * glm::dot(d, d);
         }

@@ -80,8 +80,8 @@ void accumulate_wind_forces(const Topology& topology, const State& state, const 
 }
 
 template <class F>
-void accumulate_hold_forces(const Topology& topology, const DVec3Array& position, BasicVec3Array<F>& force) {
-    for (const Hold& h : topology.holds) {
+void accumulate_soft_clip_forces(const Topology& topology, const DVec3Array& position, BasicVec3Array<F>& force) {
+    for (const SoftClipSpring& h : topology.clip_springs) {
         const glm::dvec3 f = -double(h.stiffness) * (position.get(h.particle) - h.anchor);
         force.add(h.particle, glm::vec<3, F>(f));
     }
@@ -90,8 +90,8 @@ void accumulate_hold_forces(const Topology& topology, const DVec3Array& position
 template void accumulate_spring_forces<float>(const Topology&, const DVec3Array&, const SpringSettings&, Vec3Array&);
 template void accumulate_spring_forces<double>(const Topology&, const DVec3Array&, const SpringSettings&,
                                                DVec3Array&);
-template void accumulate_hold_forces<float>(const Topology&, const DVec3Array&, Vec3Array&);
-template void accumulate_hold_forces<double>(const Topology&, const DVec3Array&, DVec3Array&);
+template void accumulate_soft_clip_forces<float>(const Topology&, const DVec3Array&, Vec3Array&);
+template void accumulate_soft_clip_forces<double>(const Topology&, const DVec3Array&, DVec3Array&);
 template void accumulate_wind_forces<float>(const Topology&, const State&, const ForceSettings&, double, Vec3Array&);
 template void accumulate_wind_forces<double>(const Topology&, const State&, const ForceSettings&, double,
                                              DVec3Array&);
@@ -108,7 +108,7 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
         const glm::dvec3 d = bend_difference(position, b);
         energy += 0.5 * double(stiffness_of(springs, b)) * glm::dot(d, d);
     }
-    for (const Hold& h : topology.holds) {
+    for (const SoftClipSpring& h : topology.clip_springs) {
         const glm::dvec3 d = position.get(h.particle) - h.anchor;
         energy += 0.5 * double(h.stiffness) * glm::dot(d, d);
     }

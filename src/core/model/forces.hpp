@@ -19,7 +19,7 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
 // Soft clips' holds (state.hpp): F = -k (x - anchor) on each held particle, computed in double and added in
 // the force type F.
 template <class F>
-void accumulate_hold_forces(const Topology& topology, const DVec3Array& position, BasicVec3Array<F>& force);
+void accumulate_soft_clip_forces(const Topology& topology, const DVec3Array& position, BasicVec3Array<F>& force);
 
 // Air velocity at a time: the wind vector scaled by deterministic gusts (two incommensurate sines, so a
 // run is reproducible and still looks irregular).

@@ -1,4 +1,4 @@
-#include "clothsim/grab_spring.hpp"
+#include "model/grab_spring.hpp"
 
 #include <glm/geometric.hpp>
 

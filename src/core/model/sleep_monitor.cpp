@@ -1,4 +1,4 @@
-#include "clothsim/sleep_monitor.hpp"
+#include "simulation/sleep_monitor.hpp"
 
 #include <glm/geometric.hpp>
 

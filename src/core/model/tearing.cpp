@@ -1,4 +1,4 @@
-#include "clothsim/tearing.hpp"
+#include "model/tearing.hpp"
 
 #include <glm/geometric.hpp>
 

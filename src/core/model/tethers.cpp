@@ -1,4 +1,4 @@
-#include "clothsim/tethers.hpp"
+#include "model/tethers.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -2,7 +2,7 @@
 // shear and bending springs (or bends, with [material]) whose rest lengths are the initial distances.
 #include "clothsim/scene.hpp"
 
-#include "clothsim/cloth_shape.hpp"
+#include "scene/cloth_shape.hpp"
 #include "clothsim/material.hpp"
 
 #include <glm/geometric.hpp>
@@ -144,7 +144,7 @@ void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& vi
             break;
         case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0, clip); break;
     }
-    for (const PinClip& p : pins.particles) pin(p.row, p.col, p.radius);
+    for (const Pin& p : pins.particles) pin(p.row, p.col, p.radius);
 }
 
 }  // namespace
@@ -152,7 +152,7 @@ void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& vi
 std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinSpec& pins) {
     std::vector<std::size_t> out;
     for_each_pinned(cloth, pins, [&](std::size_t i, double radius, double) {
-        if (radius == 0.0 || pins.clip == ClipHold::Rigid) out.push_back(i);
+        if (radius == 0.0 || pins.clip == ClipKind::Rigid) out.push_back(i);
     });
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
@@ -161,7 +161,7 @@ std::vector<std::size_t> pinned_particles(const ClothSettings& cloth, const PinS
 
 std::vector<ClipWeight> soft_clip_weights(const ClothSettings& cloth, const PinSpec& pins) {
     std::vector<ClipWeight> out;
-    if (pins.clip != ClipHold::Soft) return out;
+    if (pins.clip != ClipKind::Soft) return out;
     for_each_pinned(cloth, pins, [&](std::size_t i, double radius, double distance) {
         const double t = radius > 0.0 ? distance / radius : 1.0;
         if (t >= 1.0 - 1e-6) return;  // a point pin (rigid), or a particle on the rim: weight 0
@@ -276,10 +276,10 @@ MassSpring build_simulation(const Scene& scene) {
                           shape.has_cell(r, c);
         const double radius = std::max(w.radius, spacing);
         const double share = kClipHoldFactor / (radius * radius) * (0.25 * cells * cell_area) * w.weight;
-        Hold hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
+        SoftClipSpring hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
                   static_cast<float>(share * aspect), static_cast<float>(share / aspect)};
         hold.stiffness = hold.stiffness_for(derived.settings.springs.structural);
-        if (share > 0.0) topology.holds.push_back(hold);  // kept at k = 0 too: the springs may be raised later
+        if (share > 0.0) topology.clip_springs.push_back(hold);  // kept at k = 0 too: the springs may be raised later
     }
     return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
 }

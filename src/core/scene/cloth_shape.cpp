@@ -1,4 +1,4 @@
-#include "clothsim/cloth_shape.hpp"
+#include "scene/cloth_shape.hpp"
 
 namespace clothsim {
 

@@ -1,6 +1,6 @@
 #include "clothsim/material.hpp"
 
-#include "clothsim/cloth_shape.hpp"
+#include "scene/cloth_shape.hpp"
 #include "clothsim/scene.hpp"
 
 #include <array>

@@ -2,7 +2,7 @@
 // to_toml(), the README's field list and the panel's tooltips all read this table.
 #include "clothsim/scene.hpp"
 
-#include "clothsim/cloth_shape.hpp"
+#include "scene/cloth_shape.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
@@ -85,7 +85,7 @@ const std::array kFields = {
 
 constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corners", "top-row", "four-corners",
                                                              "left-edge"};
-constexpr std::array<std::string_view, 2> kClipHoldNames = {"rigid", "soft"};
+constexpr std::array<std::string_view, 2> kClipKindNames = {"rigid", "soft"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};
 // The integrators' names, from their table (integrator.hpp).
@@ -128,7 +128,7 @@ const FieldInfo* find_field(std::string_view name) {
 }
 
 std::span<const std::string_view> pin_preset_names() { return kPinPresetNames; }
-std::span<const std::string_view> clip_hold_names() { return kClipHoldNames; }
+std::span<const std::string_view> clip_kind_names() { return kClipKindNames; }
 std::span<const std::string_view> wind_model_names() { return kWindModelNames; }
 std::span<const std::string_view> solver_method_names() { return kSolverMethodNames; }
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
@@ -223,13 +223,13 @@ std::string format_ref(ConstFieldRef value) {
             [&](const std::string* v) { return quoted(*v); },
             [&](const PinSpec* v) {
                 std::string preset = quoted(kPinPresetNames[static_cast<int>(v->preset)]);
-                if (v->particles.empty() && v->preset_radius == 0.0f && v->clip == ClipHold::Rigid) return preset;
+                if (v->particles.empty() && v->preset_radius == 0.0f && v->clip == ClipKind::Rigid) return preset;
                 std::string out = cat("{ preset = ", preset);
                 if (v->preset_radius != 0.0f) out += cat(", radius = ", number(v->preset_radius));
-                if (v->clip != ClipHold::Rigid) out += cat(", clip = ", quoted(clip_hold_names()[static_cast<int>(v->clip)]));
+                if (v->clip != ClipKind::Rigid) out += cat(", clip = ", quoted(clip_kind_names()[static_cast<int>(v->clip)]));
                 if (v->particles.empty()) return cat(out, " }");
                 std::string list;
-                for (const PinClip& p : v->particles) {
+                for (const Pin& p : v->particles) {
                     const std::string cell = cat("[", std::to_string(p.row), ", ", std::to_string(p.col), "]");
                     const std::string pin =
                         p.radius == 0.0f ? cell : cat("{ particle = ", cell, ", radius = ", number(p.radius), " }");
@@ -319,15 +319,15 @@ void validate(const Scene& scene) {
         }
     };
     check_radius(scene.pins.preset_radius, "radius");
-    // A soft clip is a pin with a radius (ClipHold): "soft" with none would hold nothing softly, silently.
+    // A soft clip is a pin with a radius (ClipKind): "soft" with none would hold nothing softly, silently.
     const bool any_clip = (scene.pins.preset != PinPreset::None && scene.pins.preset_radius > 0.0f) ||
                           std::any_of(scene.pins.particles.begin(), scene.pins.particles.end(),
-                                      [](const PinClip& pin) { return pin.radius > 0.0f; });
-    if (scene.pins.clip == ClipHold::Soft && !any_clip) {
+                                      [](const Pin& pin) { return pin.radius > 0.0f; });
+    if (scene.pins.clip == ClipKind::Soft && !any_clip) {
         throw SceneError("pins: clip = \"soft\" has no clip to hold softly: no pin has a radius; allowed with "
                          "clip = \"soft\": pins.radius > 0 or a pin { particle = [row, col], radius = R } with R > 0");
     }
-    for (const PinClip& pin : scene.pins.particles) {
+    for (const Pin& pin : scene.pins.particles) {
         const int r = pin.row, col = pin.col;
         check_radius(pin.radius, cat("the radius of the clip at [", std::to_string(r), ", ", std::to_string(col), "]"));
         if (r < 0 || r >= c.rows || col < 0 || col >= c.cols) {

@@ -144,7 +144,7 @@ std::optional<std::pair<int, int>> pin_cell_of(const toml::node& node, const std
 }
 
 // One pin: [row, col], or a clip { particle = [row, col], radius = R }.
-std::optional<PinClip> pin_of(const toml::node& node, const std::string& name, Rejection& rejection) {
+std::optional<Pin> pin_of(const toml::node& node, const std::string& name, Rejection& rejection) {
     const toml::table* table = node.as_table();
     if (!table) {
         if (!node.is_array()) {
@@ -153,7 +153,7 @@ std::optional<PinClip> pin_of(const toml::node& node, const std::string& name, R
         }
         const auto cell = pin_cell_of(node, name, rejection);
         if (!cell) return std::nullopt;
-        return PinClip{cell->first, cell->second, 0.0f};
+        return Pin{cell->first, cell->second, 0.0f};
     }
     std::optional<std::pair<int, int>> cell;
     float radius = 0.0f;
@@ -175,11 +175,11 @@ std::optional<PinClip> pin_of(const toml::node& node, const std::string& name, R
         rejection = {name + " = " + show(node) + " names no particle; allowed: " + kClipForm, &node};
         return std::nullopt;
     }
-    return PinClip{cell->first, cell->second, radius};
+    return Pin{cell->first, cell->second, radius};
 }
 
 // A list of pins; `name` is how messages call the list ("pins", "pins.particles").
-std::optional<std::vector<PinClip>> pin_list_of(const toml::node& node, const std::string& name,
+std::optional<std::vector<Pin>> pin_list_of(const toml::node& node, const std::string& name,
                                                 Rejection& rejection) {
     const toml::array* array = node.as_array();
     if (!array) {
@@ -187,7 +187,7 @@ std::optional<std::vector<PinClip>> pin_list_of(const toml::node& node, const st
                      &node};
         return std::nullopt;
     }
-    std::vector<PinClip> out;
+    std::vector<Pin> out;
     for (std::size_t i = 0; i < array->size(); ++i) {
         const auto pin = pin_of(*array->get(i), name + "[" + std::to_string(i) + "]", rejection);
         if (!pin) return std::nullopt;
@@ -230,7 +230,7 @@ std::optional<PinSpec> pins_of(const toml::node& node, Rejection& rejection) {
                 if (!list) return std::nullopt;
                 spec.particles = *list;
             } else if (key.str() == "clip") {
-                const auto clip = enum_of<ClipHold>(value, clip_hold_names());
+                const auto clip = enum_of<ClipKind>(value, clip_kind_names());
                 if (!clip) {
                     rejection = {"pins.clip = " + show(value) + " is not a clip kind; allowed: rigid, soft", &value};
                     return std::nullopt;

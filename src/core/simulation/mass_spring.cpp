@@ -1,8 +1,8 @@
-#include "clothsim/mass_spring.hpp"
+#include "simulation/mass_spring_internals.hpp"
 
-#include "clothsim/colliders.hpp"
-#include "clothsim/tearing.hpp"
-#include "clothsim/tethers.hpp"
+#include "collision/colliders.hpp"
+#include "model/tearing.hpp"
+#include "model/tethers.hpp"
 #include "model/forces.hpp"
 #include "integrators/fast_solver.hpp"
 #include "integrators/grid_xpbd.hpp"
@@ -33,18 +33,6 @@ std::uint64_t next_stamp() {
 
 }  // namespace
 
-MassSpring::FastSolverHolder::FastSolverHolder() = default;
-MassSpring::FastSolverHolder::FastSolverHolder(std::unique_ptr<FastSolver> s) : solver(std::move(s)) {}
-MassSpring::FastSolverHolder::FastSolverHolder(const FastSolverHolder& other)
-    : solver(other.solver ? std::make_unique<FastSolver>(*other.solver) : nullptr) {}
-MassSpring::FastSolverHolder& MassSpring::FastSolverHolder::operator=(const FastSolverHolder& other) {
-    if (this != &other) solver = other.solver ? std::make_unique<FastSolver>(*other.solver) : nullptr;
-    return *this;
-}
-MassSpring::FastSolverHolder::FastSolverHolder(FastSolverHolder&&) noexcept = default;
-MassSpring::FastSolverHolder& MassSpring::FastSolverHolder::operator=(FastSolverHolder&&) noexcept = default;
-MassSpring::FastSolverHolder::~FastSolverHolder() = default;
-
 MassSpring::MassSpring(Topology topology, State state, SimulationSettings settings,
                        const std::vector<glm::vec3>& initial_velocity)
     : topology_(std::move(topology)), state_(std::move(state)), settings_(settings) {
@@ -63,10 +51,10 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     force_.resize(n);
     state_.motion.resize(n);
     build_fast_solver();
-    blocks_.start = block_starts(n, topology_.rows, topology_.cols);
+    in_->blocks.start = block_starts(n, topology_.rows, topology_.cols);
     rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
     spacing_ = particle_spacing(topology_);
-    tethers_ = build_tethers(topology_, state_, rest_position_);
+    in_->tethers = build_tethers(topology_, state_, rest_position_);
     whole_cells_ = whole_cells(topology_, n);
     surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
     replan();
@@ -78,28 +66,49 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     topology_stamp_ = next_stamp();
 }
 
-struct MassSpring::IterativeSolvers::Data : IntegratorCaches {};
-MassSpring::IterativeSolvers::IterativeSolvers() : data(std::make_unique<Data>()) {}
-MassSpring::IterativeSolvers::IterativeSolvers(const IterativeSolvers& other)
-    : data(std::make_unique<Data>(*other.data)) {}
-MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(const IterativeSolvers& other) {
-    if (this != &other) data = std::make_unique<Data>(*other.data);
+MassSpring::Internals::Internals(const Internals& other)
+    : fast(other.fast ? std::make_unique<FastSolver>(*other.fast) : nullptr),
+      iterative(other.iterative),
+      blocks(other.blocks),
+      motion_bounds(other.motion_bounds),
+      tethers(other.tethers),
+      self_collision(other.self_collision),
+      moved_uncounted(other.moved_uncounted),
+      sleep(other.sleep),
+      grab(other.grab),
+      pin_targets(other.pin_targets) {}
+
+void MassSpring::Internals::invalidate_iterative() {
+    iterative.projective.invalidate_matrix();
+    iterative.grid_xpbd_current = false;
+}
+
+MassSpring::InternalsPtr::InternalsPtr() : p_(std::make_unique<Internals>()) {}
+MassSpring::InternalsPtr::InternalsPtr(const InternalsPtr& other) : p_(std::make_unique<Internals>(*other.p_)) {}
+MassSpring::InternalsPtr& MassSpring::InternalsPtr::operator=(const InternalsPtr& other) {
+    if (this != &other) p_ = std::make_unique<Internals>(*other.p_);
     return *this;
 }
-MassSpring::IterativeSolvers::IterativeSolvers(IterativeSolvers&&) noexcept = default;
-MassSpring::IterativeSolvers& MassSpring::IterativeSolvers::operator=(IterativeSolvers&&) noexcept = default;
-MassSpring::IterativeSolvers::~IterativeSolvers() = default;
-void MassSpring::IterativeSolvers::invalidate() {
-    if (!data) return;
-    data->projective.invalidate_matrix();
-    data->grid_xpbd_current = false;
-}
+MassSpring::InternalsPtr::InternalsPtr(InternalsPtr&&) noexcept = default;
+MassSpring::InternalsPtr& MassSpring::InternalsPtr::operator=(InternalsPtr&&) noexcept = default;
+MassSpring::InternalsPtr::~InternalsPtr() = default;
+
+const CollisionBlocks& collision_blocks(const MassSpring& sim) { return sim.in_->blocks; }
 
 MassSpring::~MassSpring() = default;
 MassSpring::MassSpring(const MassSpring&) = default;
 MassSpring& MassSpring::operator=(const MassSpring&) = default;
 MassSpring::MassSpring(MassSpring&&) noexcept = default;
 MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
+
+bool MassSpring::fast_solver_available() const { return in_->fast != nullptr; }
+std::size_t MassSpring::tether_count() const { return in_->tethers.size(); }
+bool MassSpring::asleep() const { return in_->sleep.asleep(); }
+double MassSpring::calm_seconds() const { return in_->sleep.calm_seconds(); }
+std::optional<std::size_t> MassSpring::grabbed() const {
+    return in_->grab ? std::optional<std::size_t>(in_->grab->particle) : std::nullopt;
+}
+float MassSpring::grab_force_limit() const { return in_->grab ? in_->grab->force_limit : 0.0f; }
 
 const char* MassSpring::fast_kernel_name() { return FastSolver::kernel_name(); }
 
@@ -116,17 +125,17 @@ bool MassSpring::use_fast_kernel(const std::string& name) {
 
 int MassSpring::solver_threads() const {
     if (plan_.path != StepPath::FastVerlet) {
-        const bool grid = last_step_fast() && iterative_.data->grid_xpbd;
-        return grid ? iterative_.data->grid_xpbd->effective_threads(settings_.solver.threads) : 1;
+        const bool grid = last_step_fast() && in_->iterative.grid_xpbd;
+        return grid ? in_->iterative.grid_xpbd->effective_threads(settings_.solver.threads) : 1;
     }
-    const bool set_aside = settings_.solver.threads == 0 && fast_.solver->team_set_aside();
-    return set_aside ? 1 : fast_.solver->effective_threads(settings_.solver.threads);
+    const bool set_aside = settings_.solver.threads == 0 && in_->fast->team_set_aside();
+    return set_aside ? 1 : in_->fast->effective_threads(settings_.solver.threads);
 }
 
 bool MassSpring::last_step_fast() const {
     if (plan_.path == StepPath::FastVerlet) return true;
     return settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd &&
-           iterative_.data->grid_xpbd_ran;
+           in_->iterative.grid_xpbd_ran;
 }
 
 double MassSpring::substep_length() const {
@@ -137,21 +146,21 @@ void MassSpring::apply(const SimulationSettings& settings) {
     if (settings == settings_) return;
     // The projective solver's matrix holds the stiffness, the substep and the damping.
     if (settings.springs != settings_.springs || settings.integration != settings_.integration) {
-        iterative_.invalidate();
+        in_->invalidate_iterative();
     }
     // Soft clips hold in proportion to the sheet's stiffness.
     if (settings.springs.structural != settings_.springs.structural) {
-        for (Hold& hold : topology_.holds) {
+        for (SoftClipSpring& hold : topology_.clip_springs) {
             if (hold.share_u > 0.0f || hold.share_v > 0.0f) hold.stiffness = hold.stiffness_for(settings.springs.structural);
         }
     }
     settings_ = settings;
-    if (grab_) grab_->force_limit = grab_force_limit(grab_->particle);  // it follows the springs' k
+    if (in_->grab) in_->grab->force_limit = grab_force_limit(in_->grab->particle);  // it follows the springs' k
     replan();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
     // Self-collision's list and budget say nothing of what the cloth did while the stage was off or set
     // otherwise: it tests afresh at its next substep.
-    if (self_collision_) self_collision_->invalidate();
+    if (in_->self_collision) in_->self_collision->invalidate();
     setup_stamp_ = next_stamp();
 }
 
@@ -165,24 +174,24 @@ void MassSpring::set_substeps(int substeps) {
 // settings were applied; a stage the plan leaves out is not run, not even as a branch per particle.
 void MassSpring::substep() {
     const double h = substep_length();
-    if (sleep_.asleep()) {
+    if (in_->sleep.asleep()) {
         state_.time += h;
         ++profile_.slept_substeps;
         return;
     }
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
-    blocks_.positions_moving();
+    in_->blocks.positions_moving();
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
     const bool continues = stamp_ == history_stamp_;  // nothing but the last step moved the cloth since
-    if (!continues) blocks_.moved_outside_motion();    // an edit may have moved particles
+    if (!continues) in_->blocks.moved_outside_motion();    // an edit may have moved particles
     // A dragged pin moves outside the motions the broad phase and self-collision count.
-    if (!pin_targets_.empty() && move_dragged_pins()) {
-        blocks_.moved_outside_motion();
-        if (self_collision_) self_collision_->invalidate();
+    if (!in_->pin_targets.empty() && move_dragged_pins()) {
+        in_->blocks.moved_outside_motion();
+        if (in_->self_collision) in_->self_collision->invalidate();
     }
     // Self-collision's list of near pairs holds while only steps move the particles (self_collision.hpp).
-    if (!continues && self_collision_) self_collision_->invalidate();
+    if (!continues && in_->self_collision) in_->self_collision->invalidate();
 
     switch (plan_.path) {
         case StepPath::FastVerlet: step_fast(h, profile); break;
@@ -195,15 +204,15 @@ void MassSpring::substep() {
     // The fast solver's sweep may have taken the bounds of the motion it wrote; they hold until a stage moves a
     // particle.
     const bool swept_bounds = plan_.path == StepPath::FastVerlet && sweep_takes_motion_bounds();
-    const bool collided = collide(profile, swept_bounds ? &motion_bounds_ : nullptr);
-    const MotionBounds* known = swept_bounds && !collided ? &motion_bounds_ : nullptr;
+    const bool collided = collide(profile, swept_bounds ? &in_->motion_bounds : nullptr);
+    const MotionBounds* known = swept_bounds && !collided ? &in_->motion_bounds : nullptr;
     // Moves outside the motions, which self-collision's budget does not count: a collider's push now, what
     // the stages after the last substep's self stage did, and the steps of RK4 and projective, whose motion
     // (v h at the substep's end) is not the substep's displacement.
     const bool displaced = !integrator_info(integrator).motion_is_displacement;
     const bool self_moved =
-        plan_.self_collision && collide_self(profile, known, collided || moved_uncounted_ || displaced);
-    moved_uncounted_ = false;
+        plan_.self_collision && collide_self(profile, known, collided || in_->moved_uncounted || displaced);
+    in_->moved_uncounted = false;
     if (self_moved || plan_.tethers || plan_.strain_limit || plan_.speed_limit) {
         if (plan_.tethers) {
             StageTimer timer(profile, Stage::Tethers);
@@ -218,16 +227,16 @@ void MassSpring::substep() {
             StageTimer timer(profile, Stage::SpeedLimit);
             limited = limit_speed(h) || limited;
         }
-        if (self_moved || limited) blocks_.moved_outside_motion();  // pushes and limits; tethers stay inside it
-        if (plan_.tethers && tethers_at_limit_ > 0 && blocks_.carried_valid) {
+        if (self_moved || limited) in_->blocks.moved_outside_motion();  // pushes and limits; tethers stay inside it
+        if (plan_.tethers && tethers_at_limit_ > 0 && in_->blocks.carried_valid) {
             // A tether keeps its particle in the carried box but takes the outward part of its motion, which
             // moves the start of its path (x - motion, where the swept tests begin) by at most that motion.
-            blocks_.widen_carried(swept_bounds && !collided ? motion_bounds_.largest() : NAN);
+            in_->blocks.widen_carried(swept_bounds && !collided ? in_->motion_bounds.largest() : NAN);
         }
-        blocks_.positions_moving();
-        blocks_.boxes_current = box_blocks_on_team(profile);
+        in_->blocks.positions_moving();
+        in_->blocks.boxes_current = box_blocks_on_team(profile);
         const bool pushed = collide(profile);  // a push or a correction must not leave a particle inside a collider
-        moved_uncounted_ = pushed || limited || (plan_.tethers && tethers_at_limit_ > 0);
+        in_->moved_uncounted = pushed || limited || (plan_.tethers && tethers_at_limit_ > 0);
     }
     state_.time += h;
     ++profile_.substeps;
@@ -241,7 +250,7 @@ void MassSpring::substep() {
         }
         if (plan_.may_sleep) {
             StageTimer timer(profile, Stage::Sleep);
-            sleep_.check(state_, settings_.solver, h, !pin_targets_.empty());  // a pin on its way drives the cloth
+            in_->sleep.check(state_, settings_.solver, h, !in_->pin_targets.empty());  // a pin on its way drives the cloth
         }
     }
 }
@@ -253,30 +262,30 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     if (plan_.wind || plan_.contact) {
         force_.resize(state_.size());
         add_external_forces(state_, force_, external_, profile);  // onto zeros: the sums themselves
-        if (grab_) force_.add(grab_->particle, grab_force(state_));
+        if (in_->grab) force_.add(in_->grab->particle, grab_force(state_));
         external = &force_;
-    } else if (grab_ || plan_.holds) {
+    } else if (in_->grab || plan_.soft_clips) {
         // Forces on a few particles: written into an array that stays zero elsewhere, instead of summing a
         // whole array every substep (soft clips hold tens of particles of thousands).
         if (grab_external_.size() != state_.size()) grab_external_.resize(state_.size());
-        if (grab_) grab_external_.set(grab_->particle, glm::vec3(0.0f));
-        if (plan_.holds) {
-            StageTimer timer(profile, Stage::Clips);
-            for (const Hold& hold : topology_.holds) grab_external_.set(hold.particle, glm::vec3(0.0f));
-            accumulate_hold_forces(topology_, state_.position, grab_external_);
+        if (in_->grab) grab_external_.set(in_->grab->particle, glm::vec3(0.0f));
+        if (plan_.soft_clips) {
+            StageTimer timer(profile, Stage::SoftClips);
+            for (const SoftClipSpring& hold : topology_.clip_springs) grab_external_.set(hold.particle, glm::vec3(0.0f));
+            accumulate_soft_clip_forces(topology_, state_.position, grab_external_);
         }
-        if (grab_) grab_external_.add(grab_->particle, grab_force(state_));
+        if (in_->grab) grab_external_.add(in_->grab->particle, grab_force(state_));
         external = &grab_external_;
     }
     const bool boxes = plan_.colliders && settings_.solver.broad_phase;
-    if (boxes) blocks_.bounds = block_bounds_for(settings_.colliders, blocks_);
+    if (boxes) in_->blocks.bounds = block_bounds_for(settings_.colliders, in_->blocks);
     {
         StageTimer timer(profile, Stage::Fast);
-        fast_.solver->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &blocks_.boxes : nullptr,
-                           sweep_takes_motion_bounds() ? &motion_bounds_ : nullptr, blocks_.bounds);
+        in_->fast->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &in_->blocks.boxes : nullptr,
+                           sweep_takes_motion_bounds() ? &in_->motion_bounds : nullptr, in_->blocks.bounds);
     }
-    blocks_.boxes_current = boxes;
-    blocks_.current = false;  // the cloth's box is the union, made by the collision stage
+    in_->blocks.boxes_current = boxes;
+    in_->blocks.current = false;  // the cloth's box is the union, made by the collision stage
 }
 
 void MassSpring::step_textbook(double h, StepProfile* profile) {
@@ -286,26 +295,26 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
     }
     if (plan_.external_forces()) add_external_forces(state_, force_, external_, profile);
-    if (grab_) force_.add(grab_->particle, grab_force(state_));
+    if (in_->grab) force_.add(in_->grab->particle, grab_force(state_));
     {
         StageTimer timer(profile, Stage::Integrate);
         integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
     }
 }
 
-// On the fast path the tethers run on the fast solver's threads, each on the row block it has just swept, whose
-// particles are in that core's caches (one thread over the whole cloth would move the other core's block to
+// On the fast path the tethers run on the fast solver's threads, each on the band of rows it has just swept, whose
+// particles are in that core's caches (one thread over the whole cloth would move the other core's band to
 // it and back every substep). Particles project independently (tethers.hpp), so the result is the same on any
 // number of threads.
 std::size_t MassSpring::apply_tethers() {
     const double strain = settings_.springs.tether_strain;
-    if (plan_.path != StepPath::FastVerlet || !fast_.solver) return project_tethers(state_, tethers_, strain);
+    if (plan_.path != StepPath::FastVerlet || !in_->fast) return project_tethers(state_, in_->tethers, strain);
     std::array<std::size_t, 64> active{};
     const auto cols = static_cast<std::uint32_t>(topology_.cols);
-    fast_.solver->for_each_block([&](int block, int begin, int end) {
-        const std::size_t first = first_tether_from(tethers_, static_cast<std::uint32_t>(begin) * cols);
-        const std::size_t last = first_tether_from(tethers_, static_cast<std::uint32_t>(end) * cols);
-        active[static_cast<std::size_t>(block)] = project_tethers(state_, tethers_, strain, first, last);
+    in_->fast->for_each_band([&](int band, int begin, int end) {
+        const std::size_t first = first_tether_from(in_->tethers, static_cast<std::uint32_t>(begin) * cols);
+        const std::size_t last = first_tether_from(in_->tethers, static_cast<std::uint32_t>(end) * cols);
+        active[static_cast<std::size_t>(band)] = project_tethers(state_, in_->tethers, strain, first, last);
     });
     std::size_t total = 0;
     for (std::size_t a : active) total += a;
@@ -315,19 +324,19 @@ std::size_t MassSpring::apply_tethers() {
 // The same split for the boxes of the collision broad phase's blocks (block_starts' grid layout, row by
 // row), which the collision stage would otherwise make again block by block on one thread.
 bool MassSpring::box_blocks_on_team(StepProfile* profile) {
-    if (plan_.path != StepPath::FastVerlet || !fast_.solver || !plan_.colliders || !settings_.solver.broad_phase) {
+    if (plan_.path != StepPath::FastVerlet || !in_->fast || !plan_.colliders || !settings_.solver.broad_phase) {
         return false;
     }
     StageTimer timer(profile, Stage::BroadPhase);
     const int cols = topology_.cols;
     const std::size_t per_row = blocks_per_row(cols);
-    const BlockBounds bounds = block_bounds_for(settings_.colliders, blocks_);
-    blocks_.bounds = bounds;
-    blocks_.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
-    fast_.solver->for_each_block([&](int, int begin, int end) {
+    const BlockBounds bounds = block_bounds_for(settings_.colliders, in_->blocks);
+    in_->blocks.bounds = bounds;
+    in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
+    in_->fast->for_each_band([&](int, int begin, int end) {
         for (int r = begin; r < end; ++r) {
             row_block_bounds(state_.position, static_cast<std::size_t>(r) * cols, static_cast<std::size_t>(cols),
-                             blocks_.boxes.data() + static_cast<std::size_t>(r) * per_row, bounds);
+                             in_->blocks.boxes.data() + static_cast<std::size_t>(r) * per_row, bounds);
         }
     });
     return true;
@@ -340,19 +349,20 @@ bool MassSpring::sweep_takes_motion_bounds() const {
 
 bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
     if (!plan_.colliders) {
-        blocks_.moved_outside_motion();  // not grown while no stage reads it
+        in_->blocks.moved_outside_motion();  // not grown while no stage reads it
         return false;
     }
-    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, blocks_, profile, solver_threads(),
+    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, in_->blocks, profile, solver_threads(),
                          motion);
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.
 bool MassSpring::collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted) {
     StageTimer timer(profile, Stage::SelfCollision);
-    if (!self_collision_) self_collision_.emplace(topology_, rest_position_);
-    const SelfCollisionCounts counts = self_collision_->collide(state_, settings_.collision, rest_position_, known, uncounted);
+    if (!in_->self_collision) in_->self_collision.emplace(topology_, rest_position_);
+    const SelfCollisionCounts counts = in_->self_collision->collide(state_, settings_.collision, rest_position_, known, uncounted);
     if (profile) {
+        if (counts.tiles > 0) ++profile->self_tests;
         profile->self_tiles += counts.tiles;
         profile->self_tiles_active += counts.tiles_active;
         profile->self_contacts += counts.contacts;
@@ -379,8 +389,8 @@ void MassSpring::topology_changed(std::size_t removed) {
     if (removed == 0) return;
     broken_springs_ += removed;
     build_fast_solver();
-    iterative_.invalidate();
-    if (self_collision_) self_collision_->update_neighbours(topology_, rest_position_);
+    in_->invalidate_iterative();
+    if (in_->self_collision) in_->self_collision->update_neighbours(topology_, rest_position_);
     rebuild_tethers();
     surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
     replan();
@@ -390,35 +400,35 @@ void MassSpring::topology_changed(std::size_t removed) {
 
 // The fast solver's layout of the current topology, or none when it is no grid.
 void MassSpring::build_fast_solver() {
-    fast_ = FastSolverHolder{};
+    in_->fast.reset();
     if (auto solver = FastSolver::for_topology(topology_)) {
-        fast_ = FastSolverHolder(std::make_unique<FastSolver>(std::move(*solver)));
+        in_->fast = std::make_unique<FastSolver>(std::move(*solver));
     }
 }
 
 // Tethers to the current pins; after a tear only within each piece (a piece torn off falls freely).
 void MassSpring::rebuild_tethers() {
-    tethers_ = build_tethers(topology_, state_, rest_position_);
+    in_->tethers = build_tethers(topology_, state_, rest_position_);
     tethers_at_limit_ = 0;
-    if (broken_springs_ == 0 || tethers_.empty()) return;
+    if (broken_springs_ == 0 || in_->tethers.empty()) return;
     const std::vector<std::uint32_t> piece = connected_pieces(topology_, state_.size());
     Tethers kept;
-    for (std::size_t t = 0; t < tethers_.size(); ++t) {
-        if (piece[tethers_.particle[t]] != piece[tethers_.anchor[t]]) continue;
-        kept.particle.push_back(tethers_.particle[t]);
-        kept.anchor.push_back(tethers_.anchor[t]);
-        kept.rest.push_back(tethers_.rest[t]);
+    for (std::size_t t = 0; t < in_->tethers.size(); ++t) {
+        if (piece[in_->tethers.particle[t]] != piece[in_->tethers.anchor[t]]) continue;
+        kept.particle.push_back(in_->tethers.particle[t]);
+        kept.anchor.push_back(in_->tethers.anchor[t]);
+        kept.rest.push_back(in_->tethers.rest[t]);
     }
-    tethers_ = std::move(kept);
+    in_->tethers = std::move(kept);
 }
 
 void MassSpring::replan() {
-    plan_ = plan_step(topology_, settings_, fast_.solver != nullptr, !tethers_.empty());
+    plan_ = plan_step(topology_, settings_, in_->fast != nullptr, !in_->tethers.empty());
 }
 
 void MassSpring::wake() {
     substeps_since_check_ = 0;
-    if (sleep_.wake()) restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
+    if (in_->sleep.wake()) restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
 }
 
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
@@ -477,17 +487,17 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
             Vec3Array scratch;
             add_external_forces(s, f, scratch, nullptr);
         }
-        if (grab_) f.add(grab_->particle, grab_force(s));
+        if (in_->grab) f.add(in_->grab->particle, grab_force(s));
     };
     const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
-    IntegratorContext context{state_, topology_, settings_, dynamics, h, continues, *iterative_.data, {}, {}};
+    IntegratorContext context{state_, topology_, settings_, dynamics, h, continues, in_->iterative, {}, {}};
     context.frozen_external = [this](Vec3Array& f) {
         f.resize(state_.size());
         if (plan_.wind || plan_.contact) {
             Vec3Array scratch;
             add_external_forces(state_, f, scratch, nullptr, false);
         }
-        if (grab_) f.add(grab_->particle, grab_force(state_));
+        if (in_->grab) f.add(in_->grab->particle, grab_force(state_));
     };
     const IntegratorInfo& info = integrator_info(integrator);
     if (!info.substep) return;  // Verlet: substep() runs the fast solver or the textbook path
@@ -511,9 +521,9 @@ void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3A
         StageTimer timer(profile, Stage::Contact);
         accumulate_contact_forces(state, settings_.colliders, scratch);
     }
-    if (plan_.holds && holds) {
-        StageTimer timer(profile, Stage::Clips);
-        accumulate_hold_forces(topology_, state.position, scratch);
+    if (plan_.soft_clips && holds) {
+        StageTimer timer(profile, Stage::SoftClips);
+        accumulate_soft_clip_forces(topology_, state.position, scratch);
     }
     for (std::size_t i = 0; i < state.size(); ++i) force.add(i, scratch.get(i));
 }
@@ -525,18 +535,18 @@ void MassSpring::compute_forces(const State& state, Vec3Array& force) const {
         Vec3Array external;
         add_external_forces(state, force, external, nullptr);
     }
-    if (grab_) force.add(grab_->particle, grab_force(state));
+    if (in_->grab) force.add(in_->grab->particle, grab_force(state));
 }
 
 void MassSpring::grab(std::size_t i, glm::vec3 target) {
     if (state_.pinned.at(i)) return;
     wake();
-    if (!grab_ || grab_->particle != i) {
-        grab_ = GrabSpring{i, target, grab_force_limit(i)};
+    if (!in_->grab || in_->grab->particle != i) {
+        in_->grab = GrabSpring{i, target, grab_force_limit(i)};
         grab_external_ = Vec3Array{};
         grab_external_.resize(state_.size());
     }
-    grab_->target = target;
+    in_->grab->target = target;
 }
 
 // The cap: what stretches the particle's own springs by half their rest length, at least 10 m |g|.
@@ -550,21 +560,21 @@ float MassSpring::grab_force_limit(std::size_t i) const {
 }
 
 void MassSpring::release_grab() {
-    if (!grab_) return;
-    grab_.reset();
+    if (!in_->grab) return;
+    in_->grab.reset();
     grab_external_ = Vec3Array{};
     wake();
 }
 
-glm::vec3 MassSpring::grab_force() const { return grab_ ? grab_force(state_) : glm::vec3(0.0f); }
+glm::vec3 MassSpring::grab_force() const { return in_->grab ? grab_force(state_) : glm::vec3(0.0f); }
 
-glm::vec3 MassSpring::grab_force(const State& state) const { return grab_->force(state, substep_length()); }
+glm::vec3 MassSpring::grab_force(const State& state) const { return in_->grab->force(state, substep_length()); }
 
 // XPBD's residual is measured when asked, at the positions now (after collisions and limits): the step
 // itself pays nothing for it.
 double MassSpring::last_solver_residual() const {
     if (settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd) {
-        const IterativeSolvers::Data& data = *iterative_.data;
+        const IntegratorCaches& data = in_->iterative;
         if (data.grid_xpbd_ran) return data.grid_xpbd->residual(state_.position);
         return xpbd_residual(state_.position, topology_, settings_.springs, data.xpbd);
     }
@@ -615,7 +625,7 @@ std::vector<glm::vec3> MassSpring::velocities() const {
 }
 
 std::vector<glm::dvec3> MassSpring::velocities_in_double() const {
-    if (sleep_.asleep()) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
+    if (in_->sleep.asleep()) return std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0));
     if (integrator_info(state_.integrator).keeps_velocity) {
         std::vector<glm::dvec3> v(state_.size(), glm::dvec3(0.0));
         if (state_.substep > 0.0) {
@@ -682,23 +692,23 @@ void MassSpring::set_masses(std::span<const float> mass) {
     }
     // The motion (x - x_prev, or v h) is kept: velocities carry over, and the new masses act from the next
     // substep. The projective matrix holds the masses; the stability limit and the grab's cap follow them.
-    iterative_.invalidate();
-    if (grab_) grab_->force_limit = grab_force_limit(grab_->particle);
+    in_->invalidate_iterative();
+    if (in_->grab) in_->grab->force_limit = grab_force_limit(in_->grab->particle);
     wake();
     setup_stamp_ = next_stamp();
 }
 
 void MassSpring::set_pinned(std::size_t i, bool pinned) {
     if (state_.pinned.at(i) == kAbsent) return;  // outside the cloth's shape: no particle to pin or free
-    if (pinned && grab_ && grab_->particle == i) release_grab();
+    if (pinned && in_->grab && in_->grab->particle == i) release_grab();
     wake();
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
     state_.pinned.at(i) = pinned ? kPinned : 0;
     state_.inverse_mass[i] = pinned ? 0.0f : 1.0f / state_.mass[i];
-    if (!pinned) std::erase_if(pin_targets_, [&](const PinTarget& t) { return t.particle == i; });
+    if (!pinned) std::erase_if(in_->pin_targets, [&](const Internals::PinTarget& t) { return t.particle == i; });
     if (pinned) state_.motion.set(i, glm::dvec3(0.0));
-    iterative_.invalidate();  // its matrix is over the free particles
+    in_->invalidate_iterative();  // its matrix is over the free particles
     rebuild_tethers();  // the pins the cloth hangs from changed
     replan();
 }
@@ -718,18 +728,18 @@ void MassSpring::drag_pin(std::size_t i, glm::vec3 target) {
     // The whole way in one step of integration.dt, at most kPinStepPerSubstep spacings a substep.
     const double way = glm::length(to - state_.position.get(i));
     const double reach = std::min(way / std::max(settings_.integration.substeps, 1), kPinStepPerSubstep * spacing_);
-    for (PinTarget& t : pin_targets_) {
+    for (Internals::PinTarget& t : in_->pin_targets) {
         if (t.particle == i) {
             t.target = to;
             t.reach = reach;
             return;
         }
     }
-    pin_targets_.push_back({i, to, reach});
+    in_->pin_targets.push_back({i, to, reach});
 }
 
 std::optional<glm::vec3> MassSpring::pin_target(std::size_t i) const {
-    for (const PinTarget& t : pin_targets_) {
+    for (const Internals::PinTarget& t : in_->pin_targets) {
         if (t.particle == i) return glm::vec3(t.target);
     }
     return std::nullopt;
@@ -737,7 +747,7 @@ std::optional<glm::vec3> MassSpring::pin_target(std::size_t i) const {
 
 bool MassSpring::move_dragged_pins() {
     bool moved = false;
-    std::erase_if(pin_targets_, [&](const PinTarget& t) {
+    std::erase_if(in_->pin_targets, [&](const Internals::PinTarget& t) {
         const glm::dvec3 x = state_.position.get(t.particle);
         const glm::dvec3 d = t.target - x;
         const double length = glm::length(d);

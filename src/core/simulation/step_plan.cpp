@@ -12,7 +12,7 @@ std::string_view stage_name(Stage stage) {
         case Stage::Springs: return "springs";
         case Stage::Wind: return "wind";
         case Stage::Contact: return "contact";
-        case Stage::Clips: return "clips";
+        case Stage::SoftClips: return "soft clips";
         case Stage::Fast: return "fast solver";
         case Stage::Integrate: return "integrate";
         case Stage::BroadPhase: return "broad phase";
@@ -63,7 +63,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
         plan.springs[kind] = k[kind] && topology.spring_count_by_kind[kind] > 0;
     }
     plan.wind = wind_active(settings.forces);
-    plan.holds = !topology.holds.empty();
+    plan.soft_clips = !topology.clip_springs.empty();
     const ColliderSettings& c = settings.colliders;
     const bool any_enabled = std::any_of(c.shapes.begin(), c.shapes.end(), [](const Collider& s) { return s.enabled; });
     if (c.contact == ContactModel::Penalty) {
@@ -158,11 +158,11 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
                        !penalty ? "colliders.contact is projection"
                                 : (any_enabled ? "colliders.thickness is 0" : "no collider is enabled")});
     }
-    if (!plan.holds) {
-        out.push_back({Stage::Clips, Skipped, "no soft clip (pins.clip is rigid, or no pin has a radius)"});
+    if (!plan.soft_clips) {
+        out.push_back({Stage::SoftClips, Skipped, "no soft clip (pins.clip is rigid, or no pin has a radius)"});
     } else {
-        out.push_back({Stage::Clips, velocity ? Fused : Runs,
-                       std::to_string(topology.holds.size()) + " particles held" + (velocity ? ", in the integrate stage" : "")});
+        out.push_back({Stage::SoftClips, velocity ? Fused : Runs,
+                       std::to_string(topology.clip_springs.size()) + " particles held" + (velocity ? ", in the integrate stage" : "")});
     }
     out.push_back({Stage::Fast, when(fast, Skipped),
                    fast ? "springs, gravity, damping and the Verlet update, row by row"

@@ -56,7 +56,7 @@
 // their motion, so what they moved comes off the budget too.
 #pragma once
 
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 

@@ -15,7 +15,7 @@
 // its inward motion removed. A plane is a half-space and needs no sweep.
 #pragma once
 
-#include "clothsim/broad_phase.hpp"
+#include "collision/broad_phase.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 #include "clothsim/step_profile.hpp"

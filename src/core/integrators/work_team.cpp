@@ -24,7 +24,8 @@ namespace {
 constexpr int kSpins = 4000;
 
 // Blocking through the futex system call directly: sleeps while *word == expected (returns at once when it
-// differs), and wakes the sleepers on word.
+// differs), and wakes the sleepers on word. (libstdc++ 12's std::atomic::wait missed a notify at exit here:
+// a helper slept through the destructor's wake, and the program hung in join.)
 template <class T>
 void futex_wait(std::atomic<T>& word, T expected) {
     static_assert(sizeof(T) == 4 && std::atomic<T>::is_always_lock_free, "a futex is a 32-bit word");
@@ -38,11 +39,8 @@ void futex_wake_all(std::atomic<T>& word) {
 }  // namespace
 
 WorkTeam& WorkTeam::shared() {
-    // Made once and never destroyed, as an OpenMP runtime's pool: the helpers sleep in the kernel when the
-    // process exits and end with it, so no exit path waits on them (a join at exit hung when a helper had not
-    // started yet, and threads ending while LeakSanitizer stopped the process to scan it crashed its tracer).
-    static WorkTeam* const team = new WorkTeam;
-    return *team;
+    static WorkTeam team;
+    return team;
 }
 
 int WorkTeam::cores() {
@@ -51,12 +49,18 @@ int WorkTeam::cores() {
     return n;
 }
 
+WorkTeam::~WorkTeam() {
+    stop_.store(true);
+    job_.fetch_add(1);
+    futex_wake_all(job_);
+    for (std::thread& t : helpers_) t.join();
+}
 
 void WorkTeam::start_helpers(int helpers) {
     while (static_cast<int>(helpers_.size()) < helpers) {
         const int worker = static_cast<int>(helpers_.size()) + 1;
         // The job number as it is before the job about to be published: a helper that starts late still
-        // sees that job (or a later one) as new.
+        // sees that job (or a later one) as new, and one that starts after the destructor sees stop_.
         const std::uint32_t seen = job_.load();
         helpers_.emplace_back([this, worker, seen] { helper_loop(worker, seen); });
     }
@@ -115,7 +119,7 @@ void WorkTeam::work_on(std::uint32_t job, int worker) {
 void WorkTeam::helper_loop(int worker, std::uint32_t seen) {
     for (;;) {
         std::uint32_t job = seen;
-        for (int spin = 0; (job = job_.load(std::memory_order_acquire)) == seen; ++spin) {
+        for (int spin = 0; (job = job_.load(std::memory_order_acquire)) == seen && !stop_.load(); ++spin) {
             if (spin < kSpins) {
                 CLOTHSIM_PAUSE();
             } else {
@@ -126,6 +130,7 @@ void WorkTeam::helper_loop(int worker, std::uint32_t seen) {
                 sleepers_.fetch_sub(1);
             }
         }
+        if (stop_.load(std::memory_order_acquire)) return;
         seen = job;
         if (worker <= helpers_wanted_.load(std::memory_order_relaxed)) work_on(job, worker);
     }

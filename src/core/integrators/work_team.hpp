@@ -49,6 +49,7 @@ public:
 
     WorkTeam(const WorkTeam&) = delete;
     WorkTeam& operator=(const WorkTeam&) = delete;
+    ~WorkTeam();
 
 private:
     using Call = void (*)(void*, int, int);
@@ -71,6 +72,7 @@ private:
     Call call_ = nullptr;
     std::atomic<int> sleepers_{0};               // helpers blocked in the kernel on job_
     std::atomic<bool> caller_asleep_{false};     // the caller is blocked in the kernel on done_
+    std::atomic<bool> stop_{false};
     std::vector<std::thread> helpers_;
 };
 

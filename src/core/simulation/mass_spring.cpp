@@ -66,18 +66,6 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     topology_stamp_ = next_stamp();
 }
 
-MassSpring::Internals::Internals(const Internals& other)
-    : fast(other.fast ? std::make_unique<FastSolver>(*other.fast) : nullptr),
-      iterative(other.iterative),
-      blocks(other.blocks),
-      motion_bounds(other.motion_bounds),
-      tethers(other.tethers),
-      self_collision(other.self_collision),
-      moved_uncounted(other.moved_uncounted),
-      sleep(other.sleep),
-      grab(other.grab),
-      pin_targets(other.pin_targets) {}
-
 void MassSpring::Internals::invalidate_iterative() {
     iterative.projective.invalidate_matrix();
     iterative.grid_xpbd_current = false;
@@ -101,7 +89,7 @@ MassSpring& MassSpring::operator=(const MassSpring&) = default;
 MassSpring::MassSpring(MassSpring&&) noexcept = default;
 MassSpring& MassSpring::operator=(MassSpring&&) noexcept = default;
 
-bool MassSpring::fast_solver_available() const { return in_->fast != nullptr; }
+bool MassSpring::fast_solver_available() const { return in_->fast.has_value(); }
 std::size_t MassSpring::tether_count() const { return in_->tethers.size(); }
 bool MassSpring::asleep() const { return in_->sleep.asleep(); }
 double MassSpring::calm_seconds() const { return in_->sleep.calm_seconds(); }
@@ -402,7 +390,7 @@ void MassSpring::topology_changed(std::size_t removed) {
 void MassSpring::build_fast_solver() {
     in_->fast.reset();
     if (auto solver = FastSolver::for_topology(topology_)) {
-        in_->fast = std::make_unique<FastSolver>(std::move(*solver));
+        in_->fast = std::move(*solver);
     }
 }
 
@@ -423,7 +411,7 @@ void MassSpring::rebuild_tethers() {
 }
 
 void MassSpring::replan() {
-    plan_ = plan_step(topology_, settings_, in_->fast != nullptr, !in_->tethers.empty());
+    plan_ = plan_step(topology_, settings_, in_->fast.has_value(), !in_->tethers.empty());
 }
 
 void MassSpring::wake() {

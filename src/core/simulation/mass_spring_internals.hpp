@@ -14,7 +14,6 @@
 #include "model/tethers.hpp"
 #include "simulation/sleep_monitor.hpp"
 
-#include <memory>
 #include <optional>
 #include <vector>
 
@@ -28,7 +27,7 @@ struct MassSpring::Internals {
         double reach = 0.0;      // m per substep
     };
 
-    std::unique_ptr<FastSolver> fast;  // when the topology is a grid
+    std::optional<FastSolver> fast;    // when the topology is a grid
     IntegratorCaches iterative;        // projective's factorisation and BDF2 history, XPBD's multipliers and grid form
     CollisionBlocks blocks;            // particle blocks and their boxes for the collision broad phase
     MotionBounds motion_bounds;        // the fast solver's bounds of this substep's motion (sweep_takes_motion_bounds)
@@ -39,9 +38,6 @@ struct MassSpring::Internals {
     std::optional<GrabSpring> grab;
     std::vector<PinTarget> pin_targets;  // pins dragged toward a target (drag_pin), at most a few
 
-    Internals() = default;
-    Internals(const Internals& other);  // copies the fast solver too
-    Internals& operator=(const Internals&) = delete;  // MassSpring's pointer copies by construction
 
     // The stiffness, the substep, the pins or the topology changed: the projective solver factorises again and
     // XPBD's grid form is made again, at the next substep that uses them.

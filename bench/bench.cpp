@@ -3,6 +3,7 @@
 // Table-driven: every case is a scene built by the same builder as the app (build_simulation), timed as the
 // median of several repetitions, written as CSV (and JSON). See docs/PERFORMANCE.md for the results.
 #include "textbook_aos.hpp"
+#include "contention.hpp"
 #include "fma_peak.hpp"
 #include "realtime.hpp"
 #include "skipping.hpp"
@@ -191,6 +192,16 @@ int main(int argc, char** argv) {
     realtime->add_option("--threads", rt.threads, "solver.threads of the runs")->delimiter(',');
     realtime->add_option("--repeats", rt.repeats, "Interleaved runs per case (median)")->check(CLI::Range(1, 50));
     realtime->add_option("--csv", rt.csv, "Write the table as CSV");
+    bench::ContentionOptions ct;
+    CLI::App* contention = app.add_subcommand(
+        "contention", "Each threaded path with 0, 1 and 2 busy processes beside it, at 1, 2 and the default threads");
+    contention->add_option("--sizes", ct.sizes, "Grid sizes (particles per side)")->delimiter(',');
+    contention->add_option("--loads", ct.loads, "Busy processes beside the simulation")->delimiter(',');
+    contention->add_option("--paths", ct.paths, "Paths: verlet, verlet-contact, xpbd")->delimiter(',');
+    contention->add_option("--rounds", ct.rounds, "Paired rounds per case (medians)")->check(CLI::Range(1, 1000));
+    contention->add_option("--min-seconds", ct.min_seconds, "Length of one round at one thread's speed")
+        ->check(CLI::PositiveNumber);
+    contention->add_option("--csv", ct.csv, "Write the table as CSV");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -207,6 +218,7 @@ int main(int argc, char** argv) {
     if (*substep_sweep) return bench::run_substep_sweep(ss);
     if (*skipping) return bench::run_skipping(sk);
     if (*realtime) return bench::run_realtime(rt);
+    if (*contention) return bench::run_contention(ct);
 
     std::vector<Row> rows;
     try {

@@ -737,6 +737,24 @@ int finish_scripted(const AppState& app, const AppOptions& options, glm::ivec2 f
     return kExitOk;
 }
 
+// --frame-times: one CSV row per frame (the frame_ms of frame k is the wall time since frame k - 1).
+struct FrameTime {
+    float frame_ms, sim_ms, render_ms;
+    long long substeps;
+};
+
+bool write_frame_times(const std::string& path, const std::vector<FrameTime>& frames) {
+    std::string text = "frame,frame_ms,simulation_ms,render_ms,substeps\n";
+    char row[128];
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const FrameTime& f = frames[i];
+        std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%lld\n", i + 1, f.frame_ms, f.sim_ms, f.render_ms, f.substeps);
+        text += row;
+    }
+    std::string error;
+    return write_file_atomically(path, text, error);
+}
+
 // F12: a timestamped PNG in the working directory, and where it went.
 void take_screenshot(AppState& app, glm::ivec2 fb) {
     const std::string path = timestamped_screenshot_name();
@@ -756,6 +774,7 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
     bool vsync_applied = !scripted;
     auto last = Clock::now();
     const auto started = last;
+    std::vector<FrameTime> frame_times;  // --frame-times
     while (!glfwWindowShouldClose(window.get())) {
         release_held_keys(window.get(), input);
         glfwPollEvents();
@@ -773,6 +792,9 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         last = now;
         merge_requests(requests, draw_frame(app, renderer, window, scale));
         ++frame;
+        if (!options.frame_times.empty()) {
+            frame_times.push_back({app.stats.frame_ms, app.stats.sim_ms, app.stats.render_ms, app.stats.substeps_last_frame});
+        }
 
         // A GL error is a bug in the renderer: scripted runs (the tests) fail on it; interactive ones say so.
         if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
@@ -815,6 +837,10 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         app.recording.reset();
     }
     stop_imgui();
+    if (!options.frame_times.empty() && !write_frame_times(options.frame_times, frame_times)) {
+        std::cerr << "clothsim: error: cannot write " << options.frame_times << "\n";
+        if (exit_code == kExitOk) exit_code = kExitBadInput;
+    }
     return exit_code;
 }
 

@@ -26,6 +26,9 @@ struct AppOptions {
     // this many wall seconds as if the window were closed (--quit-after; exit code 0).
     bool start_paused = false;
     std::optional<double> quit_after;
+    // At exit, each frame's wall, simulation and render milliseconds and substeps as CSV (--frame-times), so
+    // a script can measure what the window costs (docs/PERFORMANCE.md, "Threads under load").
+    std::string frame_times;
     ViewSettings view;       // the View section's start values (--view)
     bool show_panel = true;
     // Auto substeps (on in interactive runs; scripted runs step exactly what the scene says unless asked).

@@ -128,6 +128,9 @@ void add_flags(CLI::App& app, CommandLine& cl) {
     app.add_option("--record", cl.app_options.record,
                    "App: with --frames, write every frame as DIR/frame-000001.png, ... (created if missing)")
         ->needs(frames);
+    app.add_option("--frame-times", cl.app_options.frame_times,
+                   "App: at exit, write each frame's milliseconds (frame, simulation, render) and substeps as CSV")
+        ->excludes(headless_flag);
     app.add_flag("--paused", cl.app_options.start_paused, "App: start paused (Space or Play runs, S steps once)")
         ->excludes(headless_flag);
     app.add_option("--quit-after", cl.app_options.quit_after, "App: close the window after this many wall seconds")

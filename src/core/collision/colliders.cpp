@@ -1,5 +1,7 @@
 #include "collision/colliders.hpp"
 
+#include "integrators/work_team.hpp"
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -100,13 +102,11 @@ long long collide_blocks(State& state, const Shape& shape, float friction, float
             blocks.grown[t] = 1;
         }
     };
-    // One thread runs no OpenMP construct at all (libgomp would make a team of one for it every time).
-    if (team > 1) {
-#pragma omp parallel for num_threads(team) schedule(dynamic, 16)
-        for (long long t = 0; t < tested; ++t) test(t);
-    } else {
-        for (long long t = 0; t < tested; ++t) test(t);
-    }
+    // Pieces of 16 blocks for the team (work_team.hpp); one thread runs them in order.
+    constexpr long long kPiece = 16;
+    WorkTeam::shared().run(team, static_cast<int>((tested + kPiece - 1) / kPiece), [&](int piece, int) {
+        for (long long t = piece * kPiece, end = std::min(tested, t + kPiece); t < end; ++t) test(t);
+    });
     for (long long t = 0; t < tested; ++t) {
         if (!blocks.grown[t]) continue;
         const Box& box = blocks.boxes[blocks.tested[t]];

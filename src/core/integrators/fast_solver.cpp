@@ -1,10 +1,10 @@
 #include "integrators/fast_solver.hpp"
+#include "integrators/work_team.hpp"
 
 #include "collision/broad_phase.hpp"
 #include "integrators/verlet.hpp"
 
 #include <immintrin.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -447,17 +447,21 @@ std::optional<FastSolver> FastSolver::for_topology(const Topology& t) {
 }
 
 int FastSolver::effective_threads(int requested) const {
-    // Read once: glibc answers hardware_concurrency() by reading /sys/devices/system/cpu/online, and this
-    // runs every substep (docs/PERFORMANCE.md and docs/RELIABILITY.md have the cost).
-    static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    const int wanted = requested > 0 ? requested : cores;
-    return std::clamp(std::min(wanted, rows_ / 8), 1, 64);
+    const int wanted = requested > 0 ? requested : WorkTeam::cores();
+    return std::clamp(std::min(wanted, rows_ / 8), 1, WorkTeam::kMaxThreads);
+}
+
+int FastSolver::band_count(int threads) const {
+    // A few bands per thread, so a thread that is descheduled holds up one small band at most while the others
+    // take the rest (work_team.hpp); each band at least 8 rows.
+    return threads <= 1 ? 1 : std::clamp(std::min(rows_ / 8, kBandsPerThread * threads), threads, kMaxBands);
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
                       double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
-    const int bands = effective_threads(settings.solver.threads);
+    const int threads = effective_threads(settings.solver.threads);
+    const int bands = band_count(threads);
     const std::size_t row_floats = 18 * spring_row_stride(cols_);
     // Buffers and the band layout are set up again only when the band count changes.
     if (bands != bands_) {
@@ -479,8 +483,8 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
                                        bounds, motion_bounds != nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
-    const bool automatic = settings.solver.threads == 0 && bands > 1;
-    const bool single = bands == 1 || (automatic && team_.next_is_single());
+    const bool automatic = settings.solver.threads == 0 && threads > 1;
+    const bool single = threads == 1 || (automatic && team_.next_is_single());
     if (motion_bounds) *motion_bounds = MotionBounds{};
     if (single) {
         const auto start = std::chrono::steady_clock::now();
@@ -489,31 +493,27 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         if (motion_bounds) *motion_bounds = reduce_lanes(scratch_[0].motion_lanes.data());
         state.substep = h;
         last_bands_ = 1;
+        last_threads_ = 1;
         return;
     }
     const auto start = std::chrono::steady_clock::now();
-#pragma omp parallel num_threads(bands)
-    {
-        // OpenMP may give fewer threads than asked (OMP_THREAD_LIMIT, OMP_DYNAMIC, nesting): every thread
-        // takes every team-size-th band, so no band is ever skipped and each is computed the same way.
-        const int team = omp_get_num_threads();
-        // Phase 1: the two spring rows above the next band read that band's first rows, which its thread
-        // will overwrite; compute them while every position is still the old one.
-        for (int b = omp_get_thread_num(); b + 1 < bands; b += team) {
-            const int next = band_begin(b + 1, bands);
-            for (int r : {next - 2, next - 1}) {
-                spring_row(state, settings.springs, spring_mask, r,
-                           boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
-            }
+    WorkTeam& team = WorkTeam::shared();
+    // Phase 1: the two spring rows above each band's first row read that band's first rows, which its sweep
+    // will overwrite; compute them while every position is still the old one.
+    team.run(threads, bands - 1, [&](int b, int) {
+        const int next = band_begin(b + 1, bands);
+        for (int r : {next - 2, next - 1}) {
+            spring_row(state, settings.springs, spring_mask, r,
+                       boundary_.data() + static_cast<std::size_t>(boundary_slot_[r]) * row_floats);
         }
-#pragma omp barrier
-        for (int b = omp_get_thread_num(); b < bands; b += team) {
-            sweep(state, sweep_settings, band_begin(b, bands), band_begin(b + 1, bands), scratch_[b],
-                  boundary_slot_);
-        }
-    }
+    });
+    // Phase 2: the bands' sweeps, each on its own rows.
+    team.run(threads, bands, [&](int b, int) {
+        sweep(state, sweep_settings, band_begin(b, bands), band_begin(b + 1, bands), scratch_[b], boundary_slot_);
+    });
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     last_bands_ = bands;
+    last_threads_ = threads;
     for (int b = 0; motion_bounds && b < bands; ++b) {
         if (band_begin(b, bands) < band_begin(b + 1, bands)) {
             motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
@@ -528,14 +528,8 @@ void FastSolver::for_each_band(const std::function<void(int, int, int)>& work) c
         work(0, 0, rows_);
         return;
     }
-#pragma omp parallel num_threads(bands)
-    {
-        // As in step(): every thread takes every team-size-th band, so band b runs on the thread that swept it.
-        const int team = omp_get_num_threads();
-        for (int b = omp_get_thread_num(); b < bands; b += team) {
-            work(b, band_begin(b, bands), band_begin(b + 1, bands));
-        }
-    }
+    WorkTeam::shared().run(last_threads_, bands,
+                           [&](int b, int) { work(b, band_begin(b, bands), band_begin(b + 1, bands)); });
 }
 
 // ---- The sweep, written once and compiled twice: for AVX2 + FMA and for the baseline ISA. ----

@@ -18,10 +18,11 @@
 //  - The state is double (state.hpp): the spring kernels take each difference in double and round it to
 //    float, the row update adds a float change to the double motion. Every particle's data is read and
 //    written once. AVX-512 (when the CPU has it) does the differences and the update 8 doubles at a time.
-//  - Threads take contiguous bands of rows. The only springs that read across a band boundary are the
-//    two spring rows just above it; they are computed before a barrier into shared storage and both
-//    neighbouring threads use the stored values. Each particle's force is summed in the same order for
-//    any partition, so the result is bit-identical for any thread count.
+//  - The rows are cut into bands, a few per thread, which the threads of the WorkTeam take one at a time
+//    (work_team.hpp: a descheduled thread delays one band, not the substep). The only springs that read
+//    across a band boundary are the two spring rows just above it; they are computed first, into shared
+//    storage, and both neighbouring bands use the stored values. Each particle's force is summed in the
+//    same order for any partition, so the result is bit-identical for any band and thread count.
 #pragma once
 
 #include "collision/broad_phase.hpp"
@@ -55,15 +56,18 @@ public:
               double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
               BlockBounds bounds = BlockBounds::Box);
 
-    // Threads the solver will really use for `requested` (0 = one per core): rows are split into bands of
-    // at least 8.
+    // Threads the solver will really use for `requested` (0 = one per core): at most one per 8 rows.
     int effective_threads(int requested) const;
+    // The bands `threads` threads split the rows into: kBandsPerThread each (one when alone), at least 8 rows
+    // each, at most kMaxBands.
+    int band_count(int threads) const;
+    static constexpr int kBandsPerThread = 4, kMaxBands = 64;
     // With threads = 0: whether the last substeps ran on one thread because the team was slower.
     bool team_set_aside() const { return team_.single(); }
-    // Runs work(band, row_begin, row_end) over all rows, split as the last substep's sweep split them, each
-    // band on the thread that swept it (all rows on this thread when the last substep ran on one): a stage
-    // that touches each particle on its own (the tethers, the collision boxes) then finds each band in the
-    // caches of the core that has just written it. Blocks are numbered from 0, at most 64 of them.
+    // Runs work(band, row_begin, row_end) over all rows, split as the last substep's sweep split them, on as
+    // many threads (all rows on this thread when the last substep ran on one): a stage that touches each
+    // particle on its own (the tethers, the collision boxes) then finds most bands in the caches of a core
+    // that has just written them. Bands are numbered from 0, at most kMaxBands of them.
     void for_each_band(const std::function<void(int, int, int)>& work) const;
     // The best kernel this CPU runs, and the one in use (the best unless a test chose another).
     static FastKernel best_kernel();
@@ -108,13 +112,14 @@ private:
     std::array<std::vector<int>, 6> fix_begin_;
     std::array<std::vector<std::pair<int, float>>, 6> fixes_;
     int bands_ = 0;                           // the band count the buffers below are laid out for
-    std::vector<Scratch> scratch_;             // one per thread
+    std::vector<Scratch> scratch_;             // one per band
     AlignedVector<float> boundary_;            // spring rows just above band boundaries
     AlignedVector<float> zeros_;               // a spring row of zeros: the rows above row 0
     std::vector<int> boundary_slot_;           // per spring row: its slot in boundary_, or -1
     std::vector<int> no_boundary_;             // all -1: one band sweeping every row
     TeamChoice team_;                          // solver.threads = 0: the team, or one thread when it is faster
-    int last_bands_ = 1;                      // the bands of the last substep (1: it ran on one thread)
+    int last_bands_ = 1;                       // the bands of the last substep (1: it ran on one thread)
+    int last_threads_ = 1;                     // the threads of the last substep
 };
 
 }  // namespace clothsim

@@ -1,10 +1,11 @@
 #include "integrators/grid_xpbd.hpp"
 
 #include "integrators/fast_solver.hpp"
+#include "integrators/work_team.hpp"
 #include "model/forces.hpp"
 
 #include <algorithm>
-#include <omp.h>
+#include <chrono>
 
 #include <cmath>
 #include <limits>
@@ -359,8 +360,8 @@ void GridXpbd::set_substep(double h) {
 
 int GridXpbd::effective_threads(int requested) const {
     const int bands = (rows_ + kBandRows - 1) / kBandRows;
-    const int wanted = requested > 0 ? requested : omp_get_num_procs();
-    return std::max(1, std::min(wanted, bands));
+    const int wanted = requested > 0 ? requested : WorkTeam::cores();
+    return std::clamp(std::min(wanted, bands), 1, WorkTeam::kMaxThreads);
 }
 
 void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int threads) {
@@ -369,7 +370,10 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     set_substep(h);
     dynamics.external(state, wind_);
     start_.x.resize(n), start_.y.resize(n), start_.z.resize(n);
-    const int team = effective_threads(threads);
+    const bool automatic = threads == 0;
+    int team = effective_threads(threads);
+    if (automatic && team > 1 && team_choice_.next_is_single()) team = 1;
+    const auto start = std::chrono::steady_clock::now();
     const std::size_t scratch = 9 * static_cast<std::size_t>(cols_);
     if (row_corrections_.size() < team * scratch) row_corrections_.assign(team * scratch, 0.0);
     // The stages this cloth has, in order.
@@ -392,22 +396,40 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     const int rows = rows_, bands = (rows_ + kBandRows - 1) / kBandRows;
     const double h2 = h * h, inv_h = 1.0 / h, damping = dynamics.damping;
     const glm::dvec3 g(dynamics.gravity);
+    double* x = state.position.x.data();
+    double* y = state.position.y.data();
+    double* z = state.position.z.data();
+    double* mx = state.motion.x.data();
+    double* my = state.motion.y.data();
+    double* mz = state.motion.z.data();
+    const float* w = state.inverse_mass.data();
+    const std::uint8_t* pinned = state.pinned.data();
+    // Each worker's pass: its own rows of corrections (work_team.hpp: worker 0 .. team - 1).
+    std::vector<Pass> passes(static_cast<std::size_t>(team));
+    const std::size_t c = static_cast<std::size_t>(cols_);
+    for (int k = 0; k < team; ++k) {
+        double* r = row_corrections_.data() + static_cast<std::size_t>(k) * scratch;
+        passes[static_cast<std::size_t>(k)] = Pass{{x, y, z, w}, rows_, cols_, &rest_, &alpha_, &lambda_, &bend_lambda_,
+                                                   {r, r + c, r + 2 * c, r + 3 * c, r + 4 * c, r + 5 * c, r + 6 * c,
+                                                    r + 7 * c, r + 8 * c, columns_.data()}};
+    }
+    WorkTeam& work_team = WorkTeam::shared();
+    // Particles in chunks of kParticleChunk, rows in chunks of kRowChunk: pieces small enough that a
+    // descheduled thread holds up little (work_team.hpp).
+    constexpr std::size_t kParticleChunk = 4096;
+    constexpr int kRowChunk = 4;
+    const int particle_chunks = static_cast<int>((n + kParticleChunk - 1) / kParticleChunk);
+    const int row_chunks = (rows + kRowChunk - 1) / kRowChunk;
+    // Each piece's sum of C^2 in its own slot, summed in index order: the same for any team.
+    std::vector<double> violation(static_cast<std::size_t>(std::max(row_chunks, bands)), 0.0);
     double violation2 = 0.0;
-    // The whole substep, run by every thread of the team (its loops are shared with `omp for`), or by this
-    // thread alone without any OpenMP construct (libgomp would make a team of one for it every time).
-    auto substep = [&]() {
-        double violation = 0.0;
-        double* x = state.position.x.data();
-        double* y = state.position.y.data();
-        double* z = state.position.z.data();
-        double* mx = state.motion.x.data();
-        double* my = state.motion.y.data();
-        double* mz = state.motion.z.data();
-        const float* w = state.inverse_mass.data();
-        const std::uint8_t* pinned = state.pinned.data();
-        // Predict with the external accelerations a = F w + g - c v, v = motion / h, as step_xpbd (accelerations()).
-#pragma omp for schedule(static)
-        for (std::size_t i = 0; i < n; ++i) {
+    auto sum_violation = [&](int pieces) {
+        for (int k = 0; k < pieces; ++k) violation2 += violation[static_cast<std::size_t>(k)];
+    };
+    // Predict with the external accelerations a = F w + g - c v, v = motion / h, as step_xpbd (accelerations()).
+    work_team.run(team, particle_chunks, [&](int chunk, int) {
+        const std::size_t begin = static_cast<std::size_t>(chunk) * kParticleChunk, end = std::min(n, begin + kParticleChunk);
+        for (std::size_t i = begin; i < end; ++i) {
             start_.x[i] = x[i], start_.y[i] = y[i], start_.z[i] = z[i];
             if (pinned[i]) continue;
             const double wi = w[i];
@@ -418,46 +440,46 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
             y[i] += my[i] + ay * h2;
             z[i] += mz[i] + az * h2;
         }
-        Pass pass{{x, y, z, w}, rows_, cols_, &rest_, &alpha_, &lambda_, &bend_lambda_, {}};
-        double* r = row_corrections_.data() + omp_get_thread_num() * scratch;
-        const std::size_t c = static_cast<std::size_t>(cols_);
-        pass.row = {r, r + c, r + 2 * c, r + 3 * c, r + 4 * c, r + 5 * c, r + 6 * c, r + 7 * c, r + 8 * c, columns_.data()};
-        for (int k = 0; k < stage_count; ++k) {
-            const Stage stage = stages[k];
-            if (stage == Stage::AlongSprings || stage == Stage::AlongSkipOne || stage == Stage::AlongBends) {
-#pragma omp for schedule(static)
-                for (int row = 0; row < rows; ++row) violation += kernel(pass, stage, row, row + 1);
-                continue;
-            }
-            // Down: each band of rows from its top, all at once; then the rows whose elements reach into the
-            // next band, each band's from its top (the order does not depend on the thread count).
-            const int span = stage == Stage::DownSkipOne || stage == Stage::DownBends ? 2 : 1;
-#pragma omp for schedule(static)
-            for (int b = 0; b < bands; ++b) {
-                const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
-                violation += kernel(pass, stage, first, last - span);  // none reaches past `last`
-            }
-#pragma omp for schedule(static)
-            for (int b = 0; b < bands; ++b) {
-                const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
-                violation += kernel(pass, stage, std::max(first, last - span), std::min(last, rows - span));
-            }
+    });
+    for (int k = 0; k < stage_count; ++k) {
+        const Stage stage = stages[k];
+        if (stage == Stage::AlongSprings || stage == Stage::AlongSkipOne || stage == Stage::AlongBends) {
+            work_team.run(team, row_chunks, [&](int chunk, int worker) {
+                const int first = chunk * kRowChunk, last = std::min(rows, first + kRowChunk);
+                double v = 0.0;
+                for (int row = first; row < last; ++row) v += kernel(passes[static_cast<std::size_t>(worker)], stage, row, row + 1);
+                violation[static_cast<std::size_t>(chunk)] = v;
+            });
+            sum_violation(row_chunks);
+            continue;
         }
-#pragma omp for schedule(static)
-        for (std::size_t i = 0; i < n; ++i) {
+        // Down: each band of rows from its top, all at once; then the rows whose elements reach into the
+        // next band, each band's from its top (the order does not depend on the thread count).
+        const int span = stage == Stage::DownSkipOne || stage == Stage::DownBends ? 2 : 1;
+        work_team.run(team, bands, [&](int b, int worker) {
+            const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
+            violation[static_cast<std::size_t>(b)] =
+                kernel(passes[static_cast<std::size_t>(worker)], stage, first, last - span);  // none reaches past `last`
+        });
+        sum_violation(bands);
+        work_team.run(team, bands, [&](int b, int worker) {
+            const int first = b * kBandRows, last = std::min(rows, first + kBandRows);
+            violation[static_cast<std::size_t>(b)] = kernel(passes[static_cast<std::size_t>(worker)], stage,
+                                                            std::max(first, last - span), std::min(last, rows - span));
+        });
+        sum_violation(bands);
+    }
+    work_team.run(team, particle_chunks, [&](int chunk, int) {
+        const std::size_t begin = static_cast<std::size_t>(chunk) * kParticleChunk, end = std::min(n, begin + kParticleChunk);
+        for (std::size_t i = begin; i < end; ++i) {
             const bool held = pinned[i] != 0;
             mx[i] = held ? 0.0 : x[i] - start_.x[i];
             my[i] = held ? 0.0 : y[i] - start_.y[i];
             mz[i] = held ? 0.0 : z[i] - start_.z[i];
         }
-        return violation;
-    };
-    if (team > 1) {
-#pragma omp parallel num_threads(team) reduction(+ : violation2)
-        violation2 += substep();
-    } else {
-        violation2 = substep();
-    }
+    });
+    if (automatic && effective_threads(0) > 1) team_choice_.record(team == 1, std::chrono::steady_clock::now() - start);
+    last_threads_ = team;
     substep_ = h;
     initial_violation_ = std::sqrt(violation2);
 }

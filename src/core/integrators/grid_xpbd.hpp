@@ -25,6 +25,7 @@
 #pragma once
 
 #include "integrators/integrators.hpp"
+#include "integrators/team_choice.hpp"
 
 #include <array>
 #include <optional>
@@ -42,11 +43,14 @@ public:
     void set_stiffness(const Topology& topology, const SpringSettings& springs);
 
     // One substep: predict with the external accelerations (gravity, wind, damping), project every element
-    // once, motion = x' - x. As step_xpbd. `threads` (0: one per core) share the bands of rows; the result is
-    // the same for any thread count.
+    // once, motion = x' - x. As step_xpbd. `threads` (0: one per core, or one alone while that is faster:
+    // team_choice.hpp) share the work in small pieces (work_team.hpp); the result is the same for any thread
+    // count.
     void step(State& state, const Dynamics& dynamics, double h, int threads);
     // The threads `requested` really gives: at most one per band of kBandRows rows.
     int effective_threads(int requested) const;
+    // The threads the last substep ran on.
+    int last_threads() const { return last_threads_; }
 
     static constexpr int kBandRows = 32;
 
@@ -75,6 +79,8 @@ private:
     DVec3Array a_, start_;
     std::vector<double> row_corrections_;  // 9 x cols: a row's corrections before they are added (grid_xpbd.cpp)
     std::vector<int> columns_;             // 0, 1, ..., cols - 1
+    TeamChoice team_choice_;               // threads = 0: the team, or one thread while it is faster
+    int last_threads_ = 1;
 };
 
 }  // namespace clothsim

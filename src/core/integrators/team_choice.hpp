@@ -1,13 +1,16 @@
-// TeamChoice: whether the fast solver's thread team is worth its barriers right now.
+// TeamChoice: whether a threaded path's team (work_team.hpp) is faster than one thread right now.
 //
-// OpenMP's barrier spins for a while, then sleeps. When another process holds one of the team's cores, the
-// descheduled thread reaches the barrier a scheduler slice late, every substep, and the team is far slower
-// than one thread (docs/PERFORMANCE.md has the figures). With solver.threads = 0 the solver therefore keeps a
-// running estimate of a substep's mean time with the team and with one thread over about the last frame, now
-// and then runs a few substeps the other way (a probe, timed on the fastest of its last two), and uses
-// whichever is faster. A probe that loses doubles the wait before the next one (64 to 4096 substeps), so a
-// team that stays slow costs little to keep checking. Results are bit-identical for any thread count
-// (fast_solver.hpp), so switching never changes the cloth.
+// A team pays for handing out work and waiting for its last piece; on a small cloth, or with another program
+// on one of the cores, one thread can be faster (docs/PERFORMANCE.md, "Threads under load"). With
+// solver.threads = 0 the fast solver and XPBD's grid form therefore keep a running estimate of a substep's
+// mean time with the team and with one thread over about the last frame, now and then run a few substeps the
+// other way (a probe, timed on the fastest of its last two), and use whichever is faster. The first probe
+// comes after kFirstProbe substeps, so both are measured within the first frame. A probe that loses doubles
+// the wait before the next one (up to kLongestWait substeps), and the wait is never shorter than what keeps
+// the probes' cost under kProbeShare of the time (a probe that cost 100 substeps' worth waits 100 /
+// kProbeShare); a probe whose counted substep takes kAbandon times the current choice's mean ends there. So a team
+// that stays slow costs little to keep checking. Results are bit-identical for any thread count
+// (fast_solver.hpp, grid_xpbd.hpp), so switching never changes the cloth.
 #pragma once
 
 #include <algorithm>
@@ -17,7 +20,9 @@ namespace clothsim {
 
 class TeamChoice {
 public:
-    static constexpr int kFirstProbe = 64, kLongestWait = 4096;  // substeps between probes
+    static constexpr int kFirstProbe = 4, kLongestWait = 4096;  // substeps between probes
+    static constexpr double kProbeShare = 0.02;  // the most of the time the probes may take
+    static constexpr double kAbandon = 4.0;      // a counted probe substep this many times the current mean ends it
     static constexpr int kProbeLength = 3;                         // substeps a probe runs the other way
     static_assert(kProbeLength >= 2, "a probe counts its substeps after the first");
 
@@ -38,11 +43,19 @@ public:
         }
         const bool probing = probe_left_ > 0;
         if (probing) {
-            // A probe's first substep moves the data into the other cores' caches and is not counted; of the
-            // others the fastest counts, so one preempted substep does not decide a probe.
-            if (probe_left_ < kProbeLength) probe_best_us_ = probe_best_us_ < 0.0 ? us : std::min(probe_best_us_, us);
+            probe_us_ += us;
+            const double current = single ? team_us_ : single_us_;  // the choice in use (the probe runs the other)
+            if (probe_left_ < kProbeLength) {
+                // A probe's first substep moves the data into the other cores' caches (and wakes the helpers)
+                // and is not counted; of the others the fastest counts, so one preempted substep does not
+                // decide a probe. A counted substep far slower than the choice in use ends the probe.
+                probe_best_us_ = probe_best_us_ < 0.0 ? us : std::min(probe_best_us_, us);
+                if (current > 0.0 && us > kAbandon * current) probe_left_ = 1;
+            }
             if (--probe_left_ > 0) return;
         }
+        const double probe_cost_us = probe_us_;
+        probe_us_ = 0.0;
         double& estimate = single ? single_us_ : team_us_;
         if (probing) {
             // A probe replaces the other choice's estimate, which is as old as the last probe (the load it saw
@@ -65,7 +78,13 @@ public:
         // The wait before the next probe doubles when a probe loses, and when the choice a probe won turns out
         // slower over its window after all (a team preempted now and then wins short probes and loses on
         // average): either way the other choice was not worth trying so soon.
-        if (probing ? single_ == was : single_ != was) wait_ = std::min(2 * wait_, kLongestWait);
+        if (probing ? single_ == was : single_ != was) wait_ = std::max(wait_, std::min(2 * wait_, kLongestWait));
+        if (probing) {
+            // The probes' share of the time: the next one waits at least its cost over kProbeShare.
+            const double mean = single_ ? single_us_ : team_us_;
+            const double cost_in_substeps = mean > 0.0 ? probe_cost_us / mean : 0.0;
+            if (single_ == was) wait_ = std::max(wait_, static_cast<int>(std::min(1e9, cost_in_substeps / kProbeShare)));
+        }
     }
     bool single() const { return single_; }
     void reset() { *this = TeamChoice{}; }
@@ -80,6 +99,7 @@ private:
     int wait_ = kFirstProbe;
     double single_us_ = -1.0, team_us_ = -1.0;
     double probe_best_us_ = -1.0;  // the fastest counted substep of the probe under way
+    double probe_us_ = 0.0;        // the time the probe under way has taken
 };
 
 }  // namespace clothsim

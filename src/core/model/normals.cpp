@@ -1,6 +1,7 @@
 #include "clothsim/normals.hpp"
 
 #include "integrators/fast_solver.hpp"
+#include "integrators/work_team.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -180,19 +181,18 @@ void compute_vertex_normals(const Topology& topology, const DVec3Array& position
     normals.resize(position.size());  // every vertex is written below
     if (position.size() == 0) return;
     const GridRows grid_rows = grid_rows_kernel();
-    // Row blocks, one per thread from 128 rows of 128 on (below that a team costs more than it saves); each
-    // block recomputes the one cell row above it, so no two threads write the same vertex.
-    static const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    // Bands of rows, one per thread from 128 rows of 128 on (below that a team costs more than it saves); each
+    // band recomputes the one cell row above it, so no two threads write the same vertex.
+    const int cores = WorkTeam::cores();
     const int rows = topology.rows;
-    const int blocks = std::clamp(static_cast<int>(position.size() / (128 * 128)), 1, std::min(cores, rows));
-    if (blocks == 1) {
+    const int bands = std::clamp(static_cast<int>(position.size() / (128 * 128)), 1, std::min(cores, rows));
+    if (bands == 1) {
         grid_rows(topology, position, 0, rows, normals);
         return;
     }
-#pragma omp parallel for num_threads(blocks) schedule(static, 1)
-    for (int b = 0; b < blocks; ++b) {
-        grid_rows(topology, position, rows * b / blocks, rows * (b + 1) / blocks, normals);
-    }
+    WorkTeam::shared().run(bands, bands, [&](int b, int) {
+        grid_rows(topology, position, rows * b / bands, rows * (b + 1) / bands, normals);
+    });
 }
 
 }  // namespace clothsim

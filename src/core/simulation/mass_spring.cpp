@@ -114,7 +114,7 @@ bool MassSpring::use_fast_kernel(const std::string& name) {
 int MassSpring::solver_threads() const {
     if (plan_.path != StepPath::FastVerlet) {
         const bool grid = last_step_fast() && in_->iterative.grid_xpbd;
-        return grid ? in_->iterative.grid_xpbd->effective_threads(settings_.solver.threads) : 1;
+        return grid ? in_->iterative.grid_xpbd->last_threads() : 1;
     }
     const bool set_aside = settings_.solver.threads == 0 && in_->fast->team_set_aside();
     return set_aside ? 1 : in_->fast->effective_threads(settings_.solver.threads);

@@ -570,7 +570,8 @@ std::string write_screenshot(const std::string& path, int width, int height) {
 
 namespace {
 
-// Dear ImGui over GLFW and OpenGL 3.3, scaled for the monitor; no ini file (the layout is fixed).
+// Dear ImGui over GLFW and OpenGL 3.3, scaled for the monitor; no ini file (the panel's layout is fixed; its
+// width is one of the app's settings, app_settings.hpp).
 void start_imgui(const Window& window, InputQueue& input, float scale) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
@@ -610,6 +611,19 @@ glm::ivec4 view_viewport(const AppState& app, const Window& window, float scale,
     return {glm::round(rect.x * to_pixels), 0, glm::round(rect.z * to_pixels), framebuffer.y};
 }
 
+// The app's settings are written when one has changed and no drag is under way (a drag of the panel's edge is
+// saved once, when the button is released).
+void save_settings_when_changed(AppState& app) {
+    const AppSettings now{app.panel_width};
+    if (app.settings_file.empty() || now == app.saved_settings || ImGui::IsMouseDown(ImGuiMouseButton_Left)) return;
+    if (const std::string error = write_app_settings(app.settings_file, now); !error.empty()) {
+        app.say("settings not saved: " + error, true);
+        app.settings_file.clear();  // told once; the run goes on with the settings in memory
+        return;
+    }
+    app.saved_settings = now;
+}
+
 // Draws the scene and the panel; returns what the panel asked for.
 PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window, float scale) {
     const auto render_start = Clock::now();
@@ -622,6 +636,7 @@ PanelRequests draw_frame(AppState& app, Renderer& renderer, const Window& window
     app.stats.times.add_frame(app.stats.profile, cloth.normals_ms, cloth.upload_ms);
     PanelRequests requests;
     if (app.show_panel) requests = draw_panel(app, scale);
+    save_settings_when_changed(app);
     if (auto chosen = app.dialogs.browser.draw(scale)) ask_for(requests, app.dialogs.browser.mode(), *chosen);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -903,7 +918,14 @@ int run_app(const Scene& scene, const AppOptions& options) {
     policy.guard = true;
     AppState app(scene, options.scene_source, policy);
     start_panel(app, options);
-    if (!scripted) app.recent = RecentFiles::from_config();  // scripted runs leave the user's list alone
+    if (!scripted) {  // scripted runs leave the user's recent files and settings alone
+        app.recent = RecentFiles::from_config();
+        app.settings_file = app_settings_file();
+        std::string warning;
+        app.saved_settings = read_app_settings(app.settings_file, warning);
+        if (!warning.empty()) app.say(warning, true);
+        app.panel_width = app.saved_settings.panel_width;
+    }
     loaded_from(app, options.scene_source);
     if (!options.record.empty()) app.recording = Recording{std::filesystem::absolute(options.record), 0, {}};
     renderer->set_cloth(app.sim);

@@ -6,6 +6,7 @@
 #include "layout.hpp"
 #include "file_browser.hpp"
 #include "file_dialog.hpp"
+#include "app_settings.hpp"
 #include "recent_files.hpp"
 #include "renderer.hpp"
 #include "scene_loading.hpp"
@@ -159,6 +160,8 @@ struct AppState {
     Messages messages;         // what the app tells the user (errors, notes, screenshot paths)
     FileDialogs dialogs;       // "Open file..." and "Save scene as..."
     RecentFiles recent{std::filesystem::path()};  // the Recent menu (read from the config folder by the app)
+    std::filesystem::path settings_file;  // where the app's settings are kept (empty: nowhere, as in scripted runs)
+    AppSettings saved_settings{kPanelWidth};  // ... as that file holds them now
     std::optional<Recording> recording;  // Record (F9)
     std::string loaded_toml;   // `loaded` as TOML: the window title marks a document that differs from it
 

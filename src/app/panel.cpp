@@ -822,16 +822,17 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     PanelRequests requests;
     const ImGuiViewport* viewport = ImGui::GetMainViewport();
     ImGui::SetNextWindowPos(viewport->WorkPos, ImGuiCond_Always);
-    // The width is the user's: a drag of the panel's right edge sets it (kept while the app runs), within
+    // The width is the user's: a drag of the panel's right edge sets it (kept between runs, app_settings.hpp), within
     // kMinPanelWidth and kMaxPanelShare of the window.
     const float max_width = std::max(kMaxPanelShare * viewport->WorkSize.x, kMinPanelWidth * content_scale);
-    ImGui::SetNextWindowSize(ImVec2(panel_width(app, content_scale, viewport->WorkSize.x), viewport->WorkSize.y),
-                             ImGuiCond_Always);
+    const float asked_width = panel_width(app, content_scale, viewport->WorkSize.x);
+    ImGui::SetNextWindowSize(ImVec2(asked_width, viewport->WorkSize.y), ImGuiCond_Always);
     ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanelWidth * content_scale, viewport->WorkSize.y),
                                         ImVec2(max_width, viewport->WorkSize.y));
     ImGui::SetNextWindowBgAlpha(0.92f);
     ImGui::Begin("clothsim", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse);
-    app.panel_width = ImGui::GetWindowWidth() / content_scale;
+    // Only a drag changes the width kept: a window too narrow for it shows it narrower, and keeps it.
+    if (std::abs(ImGui::GetWindowWidth() - asked_width) > 0.5f) app.panel_width = ImGui::GetWindowWidth() / content_scale;
     // The settings scroll; the message area below them keeps its height, so nothing moves under the mouse.
     const float message_height = 5.5f * ImGui::GetTextLineHeightWithSpacing();
     ImGui::BeginChild("settings", ImVec2(0.0f, -(message_height + ImGui::GetFrameHeightWithSpacing() +

@@ -2,6 +2,7 @@
 // keys and clicks (user_session.hpp), never with --frames. The frames a user sees before the first physics
 // step (a fast first frame, a paused app, Reset or a scene opened while paused, a click before the cloth
 // moves) are drawn from the cloth that is loaded, whatever debug view is on.
+#include "app_settings.hpp"
 #include "per_spring_scenes.hpp"
 #include "run_process.hpp"
 #include "screen.hpp"
@@ -424,6 +425,34 @@ TEST_CASE("user session: the title marks an edit, Save scene as clears the mark,
     CAPTURE_RUN(second);
     REQUIRE(second.code == 0);
     CHECK_THAT(second.out, Contains("title: clothsim - curtain\n"));
+}
+
+TEST_CASE("user session: the panel's edge dragged wider is where the next run puts it, and a bad settings file is named") {
+    const TempDir dir("session_panel_width");
+    const fs::path settings = dir / "config" / "clothsim" / "settings.toml";
+    // The edge (at kPanelWidth = 440) dragged to 530 (the widest is 45% of 1280, 576): written once the button
+    // is released.
+    const RunResult first = run_user_session(dir, {"--scene", "hanging", "--paused"}, "drag 439 300 530 300\nquit\n");
+    CAPTURE_RUN(first);
+    REQUIRE(first.code == 0);
+    REQUIRE(fs::exists(settings));
+    std::string warning;
+    const float dragged = clothsim::read_app_settings(settings, warning).panel_width;
+    CHECK(warning.empty());
+    CHECK(dragged == Approx(530.0f).margin(6.0f));
+    // The next run starts with the edge there: a drag from 530 to 480 takes the edge (were the edge at 440, it
+    // would orbit the camera and leave the file alone).
+    const RunResult second = run_user_session(dir, {"--scene", "hanging", "--paused"},
+                                              "drag " + std::to_string(static_cast<int>(dragged) - 1) + " 300 480 300\nquit\n");
+    CAPTURE_RUN(second);
+    REQUIRE(second.code == 0);
+    CHECK(clothsim::read_app_settings(settings, warning).panel_width == Approx(480.0f).margin(6.0f));
+    // A width out of range: the app says which file, line and range, and starts with the default.
+    std::ofstream(settings) << "panel_width = 5\n";
+    const RunResult third = run_user_session(dir, {"--scene", "hanging", "--paused"}, "quit\n");
+    CAPTURE_RUN(third);
+    REQUIRE(third.code == 0);
+    CHECK_THAT(third.err, Contains(settings.string() + ":1: panel_width must be a number of pixels from 300 to 4096"));
 }
 
 TEST_CASE("user session: F9 records every frame into a new folder until F9 again, each a PNG of the window") {

@@ -20,13 +20,13 @@ TEST_CASE("team choice: uses the faster of team and one thread, probing the othe
         }
         return other;
     };
-    // A healthy team: one thread loses every probe, and the waits double (4, then at least the probe's cost
-    // over kProbeShare: 255 substeps here, 510, ... 4096), so 8000 substeps hold at most 7 probes of 3
-    // substeps each.
+    // A healthy team: one thread loses every probe (each about kProbeUs long), and the waits grow (4, then at
+    // least the probe's cost over kProbeShare, doubling up to 4096), so the probes take at most a few percent
+    // of 8000 substeps' time.
     const int probed = run(8000, 100, 170);
     CHECK_FALSE(choice.single());
     CHECK(probed > 0);
-    CHECK(probed <= 7 * TeamChoice::kProbeLength);
+    CHECK(probed * 170.0 <= 2.5 * TeamChoice::kProbeShare * (8000 - probed) * 100.0);
     // The team is starved by another process: one thread wins at the next probe.
     run(8192, 5000, 170);
     CHECK(choice.single());
@@ -55,7 +55,7 @@ TEST_CASE("team choice: a preempted substep now and then does not give up a fast
     // run one thread (a fixed weight of a quarter made the team lose for 64 substeps after each such one).
     const int singles = run(20000, [](int i, bool single) { return single ? 240 : (i % 300 == 299 ? 4000 : 120); });
     CHECK_FALSE(choice.single());
-    CHECK(singles <= 9 * TeamChoice::kProbeLength);
+    CHECK(singles * 240.0 <= 2.5 * TeamChoice::kProbeShare * (20000 - singles) * 133.0);
     // A team preempted every 10th substep for 4 ms is slower on average (508 us) than one thread: given up.
     // Its probes, two substeps counted, mostly miss the preemption and win; the team then loses again over
     // its window, and each such round doubles the wait, so the team runs few of the substeps.
@@ -63,13 +63,19 @@ TEST_CASE("team choice: a preempted substep now and then does not give up a fast
     const int singles_while_preempted = run(phase, [](int i, bool single) { return single ? 240 : (i % 10 == 9 ? 4000 : 120); });
     CHECK(choice.single());
     CHECK(phase - singles_while_preempted < phase / 20);
-    // Free again, but the last substep of the probe that finds it is preempted: the faster of the two it
-    // counts decides, and the team is taken back.
+    // Free again, but the first probe that comes is preempted: it ends there and loses, and a later probe
+    // takes the team back.
     int in_a_row = 0;  // team substeps in a row
-    run(9000, [&](int, bool single) {
+    bool preempted = false;
+    run(20000, [&](int, bool single) {
         in_a_row = single ? 0 : in_a_row + 1;
-        return single ? 240 : (in_a_row == TeamChoice::kProbeLength ? 4000 : 120);
+        if (!single && in_a_row == TeamChoice::kProbeLength && !preempted) {
+            preempted = true;
+            return 4000;
+        }
+        return single ? 240 : 120;
     });
+    CHECK(preempted);
     CHECK_FALSE(choice.single());
 }
 
@@ -77,16 +83,18 @@ TEST_CASE("team choice: a preempted substep now and then does not give up a fast
 TEST_CASE("team choice: both are measured within the first frame") {
     using std::chrono::microseconds;
     TeamChoice choice;
-    // One thread 3x faster (a small cloth): taken within the first 16 substeps, so the first frame pays little:
-    // the team runs until the first probe, and one probe of its own after one thread has won.
+    // One thread 3x faster (a small cloth): taken within the first frame (16.7 ms of substeps), so that frame
+    // pays little: the team runs until the first probe, and one probe of its own (kProbeUs and its uncounted
+    // first substep) after one thread has won.
     int team_substeps = 0;
-    for (int i = 0; i < 16; ++i) {
+    for (double spent_us = 0.0; spent_us < 16667.0;) {
         const bool single = choice.next_is_single();
         team_substeps += !single;
+        spent_us += single ? 100 : 300;
         choice.record(single, microseconds(single ? 100 : 300));
     }
     CHECK(choice.single());
-    CHECK(team_substeps <= TeamChoice::kFirstProbe - 1 + TeamChoice::kProbeLength);
+    CHECK(team_substeps <= TeamChoice::kFirstProbe + 1 + static_cast<int>(TeamChoice::kProbeUs / 300.0) + 1);
 }
 
 TEST_CASE("team choice: a team a hundred times slower than one thread costs a few percent in probes, not seconds") {

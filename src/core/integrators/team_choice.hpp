@@ -23,16 +23,18 @@ public:
     static constexpr int kFirstProbe = 4, kLongestWait = 4096;  // substeps between probes
     static constexpr double kProbeShare = 0.02;  // the most of the time the probes may take
     static constexpr double kAbandon = 4.0;      // a counted probe substep this many times the current mean ends it
-    static constexpr int kProbeLength = 3;                         // substeps a probe runs the other way
+    static constexpr int kProbeLength = 3;       // the fewest substeps a probe runs the other way
+    static constexpr double kProbeUs = 2000.0;   // ... and the least time its counted substeps take
     static_assert(kProbeLength >= 2, "a probe counts its substeps after the first");
 
     // Whether the next substep should run on one thread.
     bool next_is_single() {
-        if (probe_left_ == 0 && ++since_probe_ >= wait_) {
+        if (!probing_ && ++since_probe_ >= wait_) {
             since_probe_ = 0;
-            probe_left_ = kProbeLength;
+            probing_ = true;
+            probe_substeps_ = 0;
         }
-        return probe_left_ > 0 ? !single_ : single_;
+        return probing_ ? !single_ : single_;
     }
     // Records how long a substep took with one thread (`single`) or the team, and chooses again.
     void record(bool single, std::chrono::steady_clock::duration elapsed) {
@@ -41,18 +43,24 @@ public:
             started_ = true;
             return;
         }
-        const bool probing = probe_left_ > 0;
+        const bool probing = probing_;
         if (probing) {
             probe_us_ += us;
             const double current = single ? team_us_ : single_us_;  // the choice in use (the probe runs the other)
-            if (probe_left_ < kProbeLength) {
+            if (++probe_substeps_ > 1) {
                 // A probe's first substep moves the data into the other cores' caches (and wakes the helpers)
-                // and is not counted; of the others the fastest counts, so one preempted substep does not
-                // decide a probe. A counted substep far slower than the choice in use ends the probe.
-                probe_best_us_ = probe_best_us_ < 0.0 ? us : std::min(probe_best_us_, us);
-                if (current > 0.0 && us > kAbandon * current) probe_left_ = 1;
+                // and is not counted. The others are counted for at least kProbeUs: their mean is what the
+                // choice in use is measured by too (a mean over time), so neither side is favoured by the
+                // spread of substep times a shared core gives. A counted substep far slower than the choice in
+                // use ends the probe.
+                counted_us_ += us;
+                ++counted_;
+                const bool long_enough = probe_substeps_ >= kProbeLength && counted_us_ >= kProbeUs;
+                if (!long_enough && !(current > 0.0 && us > kAbandon * current)) return;
+            } else {
+                return;
             }
-            if (--probe_left_ > 0) return;
+            probing_ = false;
         }
         const double probe_cost_us = probe_us_;
         probe_us_ = 0.0;
@@ -60,8 +68,9 @@ public:
         if (probing) {
             // A probe replaces the other choice's estimate, which is as old as the last probe (the load it saw
             // may be gone).
-            estimate = probe_best_us_;
-            probe_best_us_ = -1.0;
+            estimate = counted_us_ / counted_;
+            counted_us_ = 0.0;
+            counted_ = 0;
         } else if (estimate < 0.0) {
             estimate = us;
         } else {
@@ -94,12 +103,14 @@ private:
     static constexpr double kMaxWeight = 0.25;
     bool started_ = false;
     bool single_ = false;
-    int probe_left_ = 0;
+    bool probing_ = false;
+    int probe_substeps_ = 0;  // substeps the probe under way has run
     int since_probe_ = 0;
     int wait_ = kFirstProbe;
     double single_us_ = -1.0, team_us_ = -1.0;
-    double probe_best_us_ = -1.0;  // the fastest counted substep of the probe under way
-    double probe_us_ = 0.0;        // the time the probe under way has taken
+    double counted_us_ = 0.0;  // the probe under way: the time of its counted substeps
+    int counted_ = 0;          // ... and their number
+    double probe_us_ = 0.0;    // the time the probe under way has taken
 };
 
 }  // namespace clothsim

@@ -552,6 +552,35 @@ TEST_CASE("user session: stretch typed live on a running cloth, confirmed by a q
     CHECK(reopened.material.density == loaded.material.density);
 }
 
+TEST_CASE("user session: at 5 frames a second, a value typed and ended by a quick Enter tap is taken") {
+    const TempDir dir("session_slow_enter");
+    // stiff-drape cannot keep up with real time, so each frame spends its whole frame budget on physics; the
+    // budget typed 200 ms (Springs folded to reach it in the Integration section) makes 5 frames a second or
+    // fewer (render and the screenshots' PNGs add to it). Sleep is off so that a settled cloth keeps the frames
+    // slow. The tap's press and release then land between two frames, far apart.
+    constexpr const char* kSpringsHeader = "60 197";
+    constexpr const char* kFrameBudget = "120 553";  // with Springs folded
+    const std::string timed_frames = "t0=$(date +%s%N)\nframe\nframe\nframe\nt1=$(date +%s%N)\n"
+                                     "echo \"three frames ms: $(( (t1 - t0) / 1000000 ))\"\n";
+    const RunResult r = run_user_session(
+        dir, {"--scene", "stiff-drape", "--set", "solver.sleep_speed=0"},
+        std::string("click ") + kSpringsHeader + "\nctrl_click " + kFrameBudget + "\nkey ctrl+a\ntype 200\nkey Return\n" +
+            "click " + kSpringsHeader + "\n" + timed_frames + "ctrl_click " + kStretchWarp +
+            "\nkey ctrl+a\ntype 12000\nxdotool key Return\nsettle\nclick " + kSave +
+            "\nwait_for stiff-drape-edited.toml\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    // Three frames (each ends with a screenshot the script waits for) took at least 3 x 150 ms: 5 FPS or slower.
+    const auto at = r.out.find("three frames ms: ");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::stoi(r.out.substr(at + 17)) >= 450);
+    const fs::path saved = dir / "stiff-drape-edited.toml";
+    REQUIRE(fs::exists(saved));
+    CHECK(clothsim::load_scene(saved.string()).material.stretch.x == 12000.0f);
+    CHECK_THAT(r.err, !Contains("rebuil") && !Contains("fabric not changed"));
+}
+
 TEST_CASE("user session: the reset button and the right-click menu bring a dragged field back to the scene's value") {
     const TempDir dir("session_reset_field");
     // Damping dragged from 0.2 toward the right end (the title gains its mark); the right-click menu's first

@@ -221,7 +221,9 @@ enum class Stage { AlongSprings, Down, DownRight, DownLeft, AlongSkipOne, DownSk
 [[gnu::always_inline]] inline double project_rows(const Pass& pass, Stage stage, int first_row, int last_row) {
     const int cols = pass.cols;
     double violation2 = 0.0;
-    auto down = [&](int d, int first_col, int last_col) {
+    // Both lambdas are forced inline: a lambda left out of line is compiled for the baseline instruction set,
+    // not for the kernel's (project_avx2 and project_avx512 below).
+    auto down = [&](int d, int first_col, int last_col) __attribute__((always_inline)) {
         for (int r = first_row; r < last_row; ++r) {
             violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
                                           (*pass.lambda)[d].data(), r * cols + first_col, r * cols + last_col,
@@ -229,7 +231,7 @@ enum class Stage { AlongSprings, Down, DownRight, DownLeft, AlongSkipOne, DownSk
         }
     };
     // Springs along the rows, two apart when Span is 2: every (Span + 1)th column per pass.
-    auto along = [&]<int Span>(int d) {
+    auto along = [&]<int Span>(int d) __attribute__((always_inline)) {
         for (int r = first_row; r < last_row; ++r) {
             for (int phase = 0; phase <= Span; ++phase) {
                 violation2 += project_row_springs<Span>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
@@ -277,6 +279,59 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) double project_avx512(const
     return project_rows(pass, stage, first, last);
 }
 using Kernel = double (*)(const Pass&, Stage, int, int);
+
+// The substep's start and end, particle by particle: the prediction x += motion + a h^2 with the external
+// accelerations a = F w + g - c v, v = motion / h (step_xpbd's accelerations()), keeping the start; and the
+// motion x - start (0 for a pinned particle). Branch-free, so each loop vectorises; compiled for each
+// instruction set like the projections.
+struct Ends {
+    double *x, *y, *z, *mx, *my, *mz, *sx, *sy, *sz;
+    const float *wind_x, *wind_y, *wind_z, *w;
+    const std::uint8_t* pinned;
+    glm::dvec3 g;
+    double damping, inv_h, h2;
+};
+[[gnu::always_inline]] inline void predict_range(const Ends& e, std::size_t begin, std::size_t end) {
+    double* __restrict x = e.x;
+    double* __restrict y = e.y;
+    double* __restrict z = e.z;
+    double* __restrict sx = e.sx;
+    double* __restrict sy = e.sy;
+    double* __restrict sz = e.sz;
+    for (std::size_t i = begin; i < end; ++i) {
+        sx[i] = x[i], sy[i] = y[i], sz[i] = z[i];
+        const double wi = e.w[i];
+        const double ax = (static_cast<double>(e.wind_x[i]) * wi + e.g.x) - e.damping * (e.mx[i] * e.inv_h);
+        const double ay = (static_cast<double>(e.wind_y[i]) * wi + e.g.y) - e.damping * (e.my[i] * e.inv_h);
+        const double az = (static_cast<double>(e.wind_z[i]) * wi + e.g.z) - e.damping * (e.mz[i] * e.inv_h);
+        const bool held = e.pinned[i] != 0;
+        x[i] = held ? x[i] : x[i] + (e.mx[i] + ax * e.h2);
+        y[i] = held ? y[i] : y[i] + (e.my[i] + ay * e.h2);
+        z[i] = held ? z[i] : z[i] + (e.mz[i] + az * e.h2);
+    }
+}
+[[gnu::always_inline]] inline void motion_range(const Ends& e, std::size_t begin, std::size_t end) {
+    double* __restrict mx = e.mx;
+    double* __restrict my = e.my;
+    double* __restrict mz = e.mz;
+    for (std::size_t i = begin; i < end; ++i) {
+        const bool held = e.pinned[i] != 0;
+        mx[i] = held ? 0.0 : e.x[i] - e.sx[i];
+        my[i] = held ? 0.0 : e.y[i] - e.sy[i];
+        mz[i] = held ? 0.0 : e.z[i] - e.sz[i];
+    }
+}
+void ends_generic(const Ends& e, bool predict, std::size_t begin, std::size_t end) {
+    predict ? predict_range(e, begin, end) : motion_range(e, begin, end);
+}
+__attribute__((target("avx2,fma"))) void ends_avx2(const Ends& e, bool predict, std::size_t begin, std::size_t end) {
+    predict ? predict_range(e, begin, end) : motion_range(e, begin, end);
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) void ends_avx512(const Ends& e, bool predict, std::size_t begin,
+                                                                      std::size_t end) {
+    predict ? predict_range(e, begin, end) : motion_range(e, begin, end);
+}
+using EndsKernel = void (*)(const Ends&, bool, std::size_t, std::size_t);
 
 }  // namespace
 
@@ -391,8 +446,9 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     add(bends_ && present_[4], Stage::AlongBends);
     add(bends_ && present_[5], Stage::DownBends);
     Kernel kernel = project_generic;
-    if (FastSolver::kernel() == FastKernel::Avx2) kernel = project_avx2;
-    if (FastSolver::kernel() == FastKernel::Avx512) kernel = project_avx512;
+    EndsKernel ends_kernel = ends_generic;
+    if (FastSolver::kernel() == FastKernel::Avx2) kernel = project_avx2, ends_kernel = ends_avx2;
+    if (FastSolver::kernel() == FastKernel::Avx512) kernel = project_avx512, ends_kernel = ends_avx512;
     const int rows = rows_, bands = (rows_ + kBandRows - 1) / kBandRows;
     const double h2 = h * h, inv_h = 1.0 / h, damping = dynamics.damping;
     const glm::dvec3 g(dynamics.gravity);
@@ -426,21 +482,15 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     auto sum_violation = [&](int pieces) {
         for (int k = 0; k < pieces; ++k) violation2 += violation[static_cast<std::size_t>(k)];
     };
-    // Predict with the external accelerations a = F w + g - c v, v = motion / h, as step_xpbd (accelerations()).
-    work_team.run(team, particle_chunks, [&](int chunk, int) {
-        const std::size_t begin = static_cast<std::size_t>(chunk) * kParticleChunk, end = std::min(n, begin + kParticleChunk);
-        for (std::size_t i = begin; i < end; ++i) {
-            start_.x[i] = x[i], start_.y[i] = y[i], start_.z[i] = z[i];
-            if (pinned[i]) continue;
-            const double wi = w[i];
-            const double ax = (static_cast<double>(wind_.x[i]) * wi + g.x) - damping * (mx[i] * inv_h);
-            const double ay = (static_cast<double>(wind_.y[i]) * wi + g.y) - damping * (my[i] * inv_h);
-            const double az = (static_cast<double>(wind_.z[i]) * wi + g.z) - damping * (mz[i] * inv_h);
-            x[i] += mx[i] + ax * h2;
-            y[i] += my[i] + ay * h2;
-            z[i] += mz[i] + az * h2;
-        }
-    });
+    const Ends ends{x, y, z, mx, my, mz, start_.x.data(), start_.y.data(), start_.z.data(), wind_.x.data(), wind_.y.data(),
+                    wind_.z.data(), w, pinned, g, damping, inv_h, h2};
+    auto each_chunk = [&](bool predict) {
+        work_team.run(team, particle_chunks, [&](int chunk, int) {
+            const std::size_t begin = static_cast<std::size_t>(chunk) * kParticleChunk;
+            ends_kernel(ends, predict, begin, std::min(n, begin + kParticleChunk));
+        });
+    };
+    each_chunk(true);
     for (int k = 0; k < stage_count; ++k) {
         const Stage stage = stages[k];
         if (stage == Stage::AlongSprings || stage == Stage::AlongSkipOne || stage == Stage::AlongBends) {
@@ -469,15 +519,7 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
         });
         sum_violation(bands);
     }
-    work_team.run(team, particle_chunks, [&](int chunk, int) {
-        const std::size_t begin = static_cast<std::size_t>(chunk) * kParticleChunk, end = std::min(n, begin + kParticleChunk);
-        for (std::size_t i = begin; i < end; ++i) {
-            const bool held = pinned[i] != 0;
-            mx[i] = held ? 0.0 : x[i] - start_.x[i];
-            my[i] = held ? 0.0 : y[i] - start_.y[i];
-            mz[i] = held ? 0.0 : z[i] - start_.z[i];
-        }
-    });
+    each_chunk(false);
     if (automatic && effective_threads(0) > 1) team_choice_.record(team == 1, std::chrono::steady_clock::now() - start);
     last_threads_ = team;
     substep_ = h;

@@ -78,7 +78,7 @@ private:
     Vec3Array wind_;
     DVec3Array a_, start_;
     std::vector<double> row_corrections_;  // 9 x cols: a row's corrections before they are added (grid_xpbd.cpp)
-    std::vector<int> columns_;             // 0, 1, ..., cols - 1
+    std::vector<int> phase2_, phase3_;     // each column modulo 2 and modulo 3: its pass along a row
     TeamChoice team_choice_;               // threads = 0: the team, or one thread while it is faster
     int last_threads_ = 1;
 };

@@ -120,7 +120,9 @@ inline Scene disc_specimen(int n) {
 
 // The sanitizer build (AddressSanitizer + UBSan) looks for memory and undefined-behaviour errors, which the
 // first steps of a loop reach as well as its last: the loops over every bundled scene run a quarter of their
-// steps or frames there (kLoopShare); the Release suite runs them whole and checks the physics.
+// steps or frames there (kLoopShare); the Release suite runs them whole and checks the physics. The tests
+// tagged [convergence] (resolution studies, the settled Cusick drape) run in the Release suite only
+// (tests/CMakeLists.txt).
 #if defined(__SANITIZE_ADDRESS__)
 inline constexpr int kLoopShare = 4;
 inline constexpr bool kSanitized = true;

@@ -77,7 +77,7 @@ TEST_CASE("drape: six folds of known outline give their exact area and count", "
 }
 
 TEST_CASE("drape: the bundled cusick scene settles to folds and a drape coefficient between hanging and flat",
-          "[drape]") {
+          "[drape][convergence]") {
     Scene s = load_scene("cusick");
     s.settings.solver.threads = 1;
     MassSpring sim = build_simulation(s);

@@ -94,7 +94,7 @@ double cantilever_drop(int along, double length, double width, double bending, d
 }  // namespace
 
 TEST_CASE("material: a clamped strip's tip drop matches the heavy elastica within 3% at 33 particles and 1.5% at "
-          "65, converging", "[material]") {
+          "65, converging", "[material][convergence]") {
     // The issue's strip: 0.1 m x 0.025 m, density 0.15 kg/m^2, B = 1e-4 N m, stretch 1000 N/m (strain 1.5e-4 at
     // this load: inextensible).
     const double q = 0.15 * 9.81;
@@ -109,7 +109,7 @@ TEST_CASE("material: a clamped strip's tip drop matches the heavy elastica withi
     CHECK(std::abs(fine - exact) < std::abs(coarse - exact));
 }
 
-TEST_CASE("material: a stiff clamped strip's tip drop matches the small-deflection w L^4 / 8B", "[material]") {
+TEST_CASE("material: a stiff clamped strip's tip drop matches the small-deflection w L^4 / 8B", "[material][convergence]") {
     const double q = 0.15 * 9.81, b = 1e-2;
     const double linear = q * std::pow(0.1, 4) / (8.0 * b);
     REQUIRE(elastica_tip_drop(0.1, b, q) == Approx(linear).epsilon(1e-3));  // the elastica agrees here
@@ -459,7 +459,7 @@ double shape_distance(const std::vector<glm::dvec3>& coarse, int n, const std::v
 }  // namespace
 
 TEST_CASE("material: hanging settled at 17, 33 and 65 particles a side converges to one shape: the distance between "
-          "successive resolutions at least halves per doubling (with the scene's tethers)", "[material]") {
+          "successive resolutions at least halves per doubling (with the scene's tethers)", "[material][convergence]") {
     // Point pins (clip 0) as the bundled scene has them: nested grids, the pins on the same material points.
     // With the scene's tethers at 1% (measured 8.2, 3.2 mm, and 0.95 mm to 129): the issue's factor 2.
     const auto a = hanging_settled(17, 5.0, 0.0f, 1e-4f, 6.0f, 1000.0f, 0.01f);

@@ -314,16 +314,21 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
 // its 1.87 input queue) reads each key's state once a frame, in NewFrame, so a key pressed and released
 // between two frames (a quick tap at a low frame rate) never reaches it: Enter would not end a typed value.
 // The queue hands ImGui the press at once and holds back a release of a key pressed since the last frame
-// until that frame has seen the key down, so every tap counts once.
+// until that frame has seen the key down, so every tap counts once. For the same reason it holds back every
+// key release that follows a mouse press between two frames: ImGui sees the click with the modifiers held
+// when it was made (a quick ctrl+click at 5 frames a second would otherwise reach it as a plain click, and a
+// plain click on a slider sets it to the value under the mouse).
 struct InputQueue {
     std::vector<int> pressed;          // this frame's presses, for the app's own keys
     std::vector<std::string> dropped;  // paths dropped onto the window since the last frame
     GLFWkeyfun imgui_key = nullptr;    // ImGui's key callback, which this queue feeds
+    GLFWmousebuttonfun imgui_mouse_button = nullptr;  // ... and its mouse button callback
     struct Release {
         int key, scancode, mods;
     };
     std::vector<int> down_this_frame;   // keys pressed since the last frame
-    std::vector<Release> held_releases; // their releases, handed to ImGui after the frame
+    bool clicked_this_frame = false;    // a mouse button pressed since the last frame
+    std::vector<Release> held_releases; // releases handed to ImGui after the frame
 };
 
 void on_key(GLFWwindow* window, int key, int scancode, int action, int mods) {
@@ -334,16 +339,25 @@ void on_key(GLFWwindow* window, int key, int scancode, int action, int mods) {
         queue->down_this_frame.push_back(key);
     }
     if (action == GLFW_RELEASE &&
-        std::find(queue->down_this_frame.begin(), queue->down_this_frame.end(), key) != queue->down_this_frame.end()) {
+        (queue->clicked_this_frame ||
+         std::find(queue->down_this_frame.begin(), queue->down_this_frame.end(), key) != queue->down_this_frame.end())) {
         queue->held_releases.push_back({key, scancode, mods});
         return;
     }
     if (queue->imgui_key) queue->imgui_key(window, key, scancode, action, mods);
 }
 
+void on_mouse_button(GLFWwindow* window, int button, int action, int mods) {
+    auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
+    if (!queue) return;
+    if (action == GLFW_PRESS) queue->clicked_this_frame = true;
+    if (queue->imgui_mouse_button) queue->imgui_mouse_button(window, button, action, mods);
+}
+
 // Before the next events are read: the releases held back reach ImGui, which saw their keys down last frame.
 void release_held_keys(GLFWwindow* window, InputQueue& queue) {
     queue.down_this_frame.clear();
+    queue.clicked_this_frame = false;
     for (const InputQueue::Release& r : std::exchange(queue.held_releases, {})) {
         if (queue.imgui_key) queue.imgui_key(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
     }
@@ -585,8 +599,9 @@ void start_imgui(const Window& window, InputQueue& input, float scale) {
     glfwSetWindowUserPointer(window.get(), &input);
     glfwSetDropCallback(window.get(), on_drop);
     ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
-    // In front of ImGui's key callback, which the queue then feeds (InputQueue).
+    // In front of ImGui's key and mouse button callbacks, which the queue then feeds (InputQueue).
     input.imgui_key = glfwSetKeyCallback(window.get(), on_key);
+    input.imgui_mouse_button = glfwSetMouseButtonCallback(window.get(), on_mouse_button);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 }
 

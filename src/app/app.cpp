@@ -4,6 +4,7 @@
 
 #include "app_state.hpp"
 #include "camera.hpp"
+#include "frame_log.hpp"
 #include "gl.hpp"
 #include "layout.hpp"
 #include "picking.hpp"
@@ -767,24 +768,6 @@ int finish_scripted(const AppState& app, const AppOptions& options, glm::ivec2 f
     return kExitOk;
 }
 
-// --frame-times: one CSV row per frame (the frame_ms of frame k is the wall time since frame k - 1).
-struct FrameTime {
-    float frame_ms, sim_ms, render_ms;
-    long long substeps;
-};
-
-bool write_frame_times(const std::string& path, const std::vector<FrameTime>& frames) {
-    std::string text = "frame,frame_ms,simulation_ms,render_ms,substeps\n";
-    char row[128];
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-        const FrameTime& f = frames[i];
-        std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%lld\n", i + 1, f.frame_ms, f.sim_ms, f.render_ms, f.substeps);
-        text += row;
-    }
-    std::string error;
-    return write_file_atomically(path, text, error);
-}
-
 // F12: a timestamped PNG in the working directory, and where it went.
 void take_screenshot(AppState& app, glm::ivec2 fb) {
     const std::string path = timestamped_screenshot_name();
@@ -796,6 +779,15 @@ void take_screenshot(AppState& app, glm::ivec2 fb) {
 // what the frame asked for. Returns the exit code.
 int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOptions& options, float scale) {
     const bool scripted = options.frames.has_value();
+    std::optional<FrameLog> frame_log;  // --frame-times
+    if (!options.frame_times.empty()) {
+        try {
+            frame_log.emplace(options.frame_times);
+        } catch (const std::exception& e) {
+            std::cerr << "clothsim: error: --frame-times: " << e.what() << "\n";
+            return kExitBadInput;
+        }
+    }
     InputQueue input;
     start_imgui(window, input, scale);
     std::string title;
@@ -804,7 +796,6 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
     bool vsync_applied = !scripted;
     auto last = Clock::now();
     const auto started = last;
-    std::vector<FrameTime> frame_times;  // --frame-times
     while (!glfwWindowShouldClose(window.get())) {
         release_held_keys(window.get(), input);
         glfwPollEvents();
@@ -822,8 +813,11 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         last = now;
         merge_requests(requests, draw_frame(app, renderer, window, scale));
         ++frame;
-        if (!options.frame_times.empty()) {
-            frame_times.push_back({app.stats.frame_ms, app.stats.sim_ms, app.stats.render_ms, app.stats.substeps_last_frame});
+        if (frame_log && !frame_log->write({app.stats.frame_ms, app.stats.sim_ms, app.stats.render_ms,
+                                            app.stats.substeps_last_frame}, app.sim)) {
+            std::cerr << "clothsim: error: --frame-times: cannot write " << options.frame_times << "\n";
+            frame_log.reset();
+            exit_code = kExitBadInput;
         }
 
         // A GL error is a bug in the renderer: scripted runs (the tests) fail on it; interactive ones say so.
@@ -867,10 +861,6 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
         app.recording.reset();
     }
     stop_imgui();
-    if (!options.frame_times.empty() && !write_frame_times(options.frame_times, frame_times)) {
-        std::cerr << "clothsim: error: cannot write " << options.frame_times << "\n";
-        if (exit_code == kExitOk) exit_code = kExitBadInput;
-    }
     return exit_code;
 }
 

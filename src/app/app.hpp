@@ -26,7 +26,7 @@ struct AppOptions {
     // this many wall seconds as if the window were closed (--quit-after; exit code 0).
     bool start_paused = false;
     std::optional<double> quit_after;
-    // At exit, each frame's wall, simulation and render milliseconds and substeps as CSV (--frame-times), so
+    // A CSV row per frame as it ends (--frame-times, frame_log.hpp): its costs and the cloth's state, so
     // a script can measure what the window costs (docs/PERFORMANCE.md, "Threads under load").
     std::string frame_times;
     ViewSettings view;       // the View section's start values (--view)

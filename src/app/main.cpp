@@ -129,7 +129,7 @@ void add_flags(CLI::App& app, CommandLine& cl) {
                    "App: with --frames, write every frame as DIR/frame-000001.png, ... (created if missing)")
         ->needs(frames);
     app.add_option("--frame-times", cl.app_options.frame_times,
-                   "App: at exit, write each frame's milliseconds (frame, simulation, render) and substeps as CSV")
+                   "App: write a CSV row per frame as it ends: milliseconds (frame, simulation, render), substeps, and the cloth (time, max_move, max_speed, mean_strain, kinetic_energy, centroid)")
         ->excludes(headless_flag);
     app.add_flag("--paused", cl.app_options.start_paused, "App: start paused (Space or Play runs, S steps once)")
         ->excludes(headless_flag);

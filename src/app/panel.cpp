@@ -360,9 +360,16 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
             const SpringConstants k = spring_constants(edit.cloth, edit.material);
             ImGui::TextDisabled("per spring: structural %.4g / %.4g, shear %.4g N/m", k.structural.x,
                                 k.structural.y, k.shear);
+            // A stretch the grid cannot give (the diagonals alone are stiffer): said in the message area while it
+            // holds and marked on this line, so the rows below never move as a slider crosses it.
+            if (!k.note.empty()) {
+                ImGui::SameLine();
+                ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "(!)");
+                if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", k.note.c_str());
+                app.say(k.note);
+            }
             ImGui::TextDisabled("bends %.4g / %.4g N/m; Poisson ratio %.3f / %.3f", k.bending.x, k.bending.y,
                                 k.poisson_uv, k.poisson_vu);
-            if (!k.note.empty()) ImGui::TextWrapped("%s", k.note.c_str());
         } catch (const SceneError& e) {
             ImGui::TextWrapped("%s", e.what());
         }

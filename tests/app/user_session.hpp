@@ -120,4 +120,18 @@ exit $code
     return run_process("timeout", {"300", "bash", script.string()});
 }
 
+// A stand-in zenity in dir/bin running the shell `body`, and the environment that puts it first on PATH.
+// The app polls its answer whenever it comes, so a test does not depend on when a dialog has appeared.
+inline std::string stand_in_zenity(const TempDir& dir, const std::string& body) {
+    std::filesystem::create_directories(dir / "bin");
+    std::ofstream(dir / "bin" / "zenity") << "#!/bin/sh\n" << body << "\n";
+    std::filesystem::permissions(dir / "bin" / "zenity", std::filesystem::perms::owner_all);
+    return "CLOTHSIM_FILE_DIALOG=auto PATH=" + quote((dir / "bin").string()) + ":\"$PATH\"";
+}
+
+// One that answers a save with the file it proposes, as a user pressing Save does.
+inline std::string zenity_saving_as_proposed(const TempDir& dir) {
+    return stand_in_zenity(dir, "for a in \"$@\"; do case \"$a\" in --filename=*) echo \"${a#--filename=}\"; exit 0 ;; esac; done\nexit 1");
+}
+
 }  // namespace clothsim::test

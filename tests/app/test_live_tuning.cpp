@@ -60,14 +60,16 @@ std::string number(double v) {
 }
 
 // The session's own actions: waits on the simulated time in the log, and marks of which frame a change began
-// and ended in. `frame` waits on the log too (two more rows: a whole frame has run since the call), which costs
-// nothing, where the F12 screenshot it replaces writes a PNG.
+// and ended in. `frame` and `settle` wait on the log too (two and three more rows: one and two whole frames
+// since the call), which costs nothing, where the F12 screenshots they replace write PNGs.
 const char* kLogActions = R"sh(
 rows() { awk 'END { print NR }' frames.csv 2>/dev/null; }
-frame() {
+rows_more() {
   local n; n=$(rows)
-  for _ in $(seq 3000); do [ "$(rows)" -ge $((n + 2)) ] && return; kill -0 $app 2>/dev/null || return; sleep 0.02; done
+  for _ in $(seq 3000); do [ "$(rows)" -ge $((n + $1)) ] && return; kill -0 $app 2>/dev/null || return; sleep 0.02; done
 }
+frame() { rows_more 2; }
+settle() { rows_more 3; }  # two whole frames after the call
 sim_time() { awk -F, 'END { print $6 }' frames.csv 2>/dev/null; }  # (cut is the knife's action)
 wait_until() {
   for _ in $(seq 3000); do
@@ -144,7 +146,9 @@ void tune_live(const std::string& name, Expect expect) {
                "drag " + xy(weft + from, kStretchY) + " " + xy(weft + to, kStretchY) + "\n";
     };
     auto typed = [](const char* at, const std::string& value) {
-        return std::string("ctrl_click ") + at + "\nkey ctrl+a\ntype " + value + "\nxdotool key Return\nsettle\n";
+        // The text and a quick Return in one go: ImGui takes a frame's characters before its keys.
+        return std::string("ctrl_click ") + at + "\nkey ctrl+a\nxdotool type --delay 40 " + value +
+               "\nxdotool key Return\nsettle\n";
     };
     const std::string actions =
         std::string(kLogActions) + "wait_until 0.5\n" +

@@ -7,9 +7,10 @@
 // What must hold on every scene: no frame moves a particle further than the fastest speed seen could carry it
 // in that frame (a restart or a rebuild puts the cloth back at its start: a jump), no message on stderr (the
 // guard, a pause, a failed rebuild), and the document keeps the values set. What each change must do to the
-// cloth, where the physics says it shows (the issue asks for 2 simulated seconds; the stretch shows in 1):
-//   stretch 10x   within 1 s the mean strain of the structural springs falls below half of what it was
-//   stretch 0.1x  within 1 s it rises above twice what it was (from the 10x state)
+// cloth, where the physics says it shows (the issue asks for 2 simulated seconds; the stretch shows in 1;
+// measured ratios of the second strain to the first: 13 on pile to 148 on tear):
+//   stretch       the mean strain of the structural springs, averaged over the second after each drag, is
+//                 lower at 10x than before, and at 0.1x at least 3 times what it was at 10x
 //   wind +6 m/s   along +x: within 2 s the centroid moves at least 3 mm along +x
 // Two exceptions, from the physics: `falling` lies asleep and flat on the ground (no strain to change; wind
 // parallel to a flat cloth exerts no force in the triangle wind model: drag on each triangle along its normal, docs/SCENE_FILES.md, as does `pile` for the
@@ -115,6 +116,7 @@ std::map<std::string, std::size_t> read_marks(const fs::path& file) {
 // The rows of a change: from the frame it began in to 2 simulated seconds after the frame it ended in.
 struct Window {
     std::size_t begin, end;  // row indices: [begin, end)
+    std::size_t changed;     // the row the change's last action ended in
 };
 Window change_window(const std::vector<Row>& rows, const std::map<std::string, std::size_t>& marks, const std::string& name,
                      double seconds = 2.0) {
@@ -126,7 +128,7 @@ Window change_window(const std::vector<Row>& rows, const std::map<std::string, s
     while (end < rows.size() && rows[end].time <= rows[last].time + seconds) ++end;
     INFO(name << ": the log ends " << rows.back().time - rows[last].time << " s after the change");
     REQUIRE(rows.back().time >= rows[last].time + 0.95 * seconds);
-    return {begin, end};
+    return {begin, end, last};
 }
 
 struct Expect {
@@ -202,11 +204,19 @@ void tune_live(const std::string& name, Expect expect) {
     const auto strain = [](const Row& row) { return row.mean_strain; };
     const auto centroid_x = [](const Row& row) { return row.centroid_x; };
     if (expect.stretch_shows) {
+        // The strain, averaged over the second after each drag ended, at 0.1x against 10x (100 times softer): a
+        // single frame's strain is no measure, as a moving cloth's (fold's, flag's) swings 2x by itself.
         const Window up = change_window(rows, marks, "stretch10", 1.0), down = change_window(rows, marks, "stretch01", 1.0);
-        INFO("mean strain before 10x " << rows[up.begin].mean_strain << ", least after " << extreme(up, strain, false));
-        CHECK(extreme(up, strain, false) <= 0.5 * rows[up.begin].mean_strain);
-        INFO("mean strain before 0.1x " << rows[down.begin].mean_strain << ", most after " << extreme(down, strain, true));
-        CHECK(extreme(down, strain, true) >= 2.0 * rows[down.begin].mean_strain);
+        auto average = [&](Window w) {
+            double sum = 0.0;
+            for (std::size_t k = w.changed; k < w.end; ++k) sum += rows[k].mean_strain;
+            return sum / double(w.end - w.changed);
+        };
+        const double stiff = average(up), soft = average(down);
+        INFO("mean strain before 10x " << rows[up.begin].mean_strain << ", over the second at 10x " << stiff
+                                       << ", at 0.1x " << soft);
+        CHECK(soft >= 3.0 * stiff);
+        CHECK(stiff < rows[up.begin].mean_strain);
     }
     if (expect.wind_shows) {
         const Window wind = change_window(rows, marks, "wind");

@@ -201,7 +201,6 @@ void tune_live(const std::string& name, Expect expect) {
         for (std::size_t k = w.begin; k < w.end; ++k) e = largest ? std::max(e, field(rows[k])) : std::min(e, field(rows[k]));
         return e;
     };
-    const auto strain = [](const Row& row) { return row.mean_strain; };
     const auto centroid_x = [](const Row& row) { return row.centroid_x; };
     if (expect.stretch_shows) {
         // The strain, averaged over the second after each drag ended, at 0.1x against 10x (100 times softer): a

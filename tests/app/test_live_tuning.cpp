@@ -14,7 +14,7 @@
 //   wind +6 m/s   along +x: within 2 s the centroid moves at least 3 mm along +x
 // Two exceptions, from the physics: `falling` lies asleep and flat on the ground (no strain to change; wind
 // parallel to a flat cloth exerts no force in the triangle wind model: drag on each triangle along its normal, docs/SCENE_FILES.md, as does `pile` for the
-// wind; and `stiff-drape`'s XPBD (32 substeps of one iteration) is iteration-bound: its strain, 3.0e-3, is
+// wind; `tear` once its gusts have ripped it free (it lies slack); and `stiff-drape`'s XPBD (32 substeps of one iteration) is iteration-bound: its strain, 3.0e-3, is
 // the same at 400, 4033 and 40330 N/m (docs/STIFF_CLOTH.md), so its stretch slider shows nothing there.
 #include "run_process.hpp"
 #include "user_session.hpp"
@@ -134,6 +134,9 @@ Window change_window(const std::vector<Row>& rows, const std::map<std::string, s
 struct Expect {
     bool stretch_shows = true;
     bool wind_shows = true;
+    // tear rips free in its gusts (sooner with the wind typed stronger) and may lie slack on the ground by the
+    // time the stretch is dragged: then it has no strain for the stretch to change.
+    bool may_tear_free = false;
 };
 
 void tune_live(const std::string& name, Expect expect) {
@@ -202,7 +205,10 @@ void tune_live(const std::string& name, Expect expect) {
         return e;
     };
     const auto centroid_x = [](const Row& row) { return row.centroid_x; };
-    if (expect.stretch_shows) {
+    const bool torn_free = expect.may_tear_free && marks.count("stretch10-begin") &&
+                           std::abs(rows.at(marks.at("stretch10-begin") - 1).mean_strain) < 1e-5;
+    if (torn_free) WARN(name << " had torn free and lay slack when the stretch was dragged");
+    if (expect.stretch_shows && !torn_free) {
         // The strain, averaged over the second after each drag ended, at 0.1x against 10x (100 times softer): a
         // single frame's strain is no measure, as a moving cloth's (fold's, flag's) swings 2x by itself.
         const Window up = change_window(rows, marks, "stretch10", 1.0), down = change_window(rows, marks, "stretch01", 1.0);
@@ -257,4 +263,6 @@ TEST_CASE("live tuning: stiff-drape takes wind and damping (its XPBD strain is i
 TEST_CASE("live tuning: stiff-hanging takes wind, damping and stretch while it runs", "[every-scene]") {
     tune_live("stiff-hanging", {});
 }
-TEST_CASE("live tuning: tear takes wind, damping and stretch while it runs", "[every-scene]") { tune_live("tear", {}); }
+TEST_CASE("live tuning: tear takes wind, damping and stretch while it runs (unless it has torn free)", "[every-scene]") {
+    tune_live("tear", {.may_tear_free = true});
+}

@@ -12,10 +12,11 @@
 //   stretch       the mean strain of the structural springs, averaged over the second after each drag, is
 //                 lower at 10x than before, and at 0.1x at least 3 times what it was at 10x
 //   wind +6 m/s   along +x: within 2 s the centroid moves at least 3 mm along +x
-// Two exceptions, from the physics: `falling` lies asleep and flat on the ground (no strain to change; wind
-// parallel to a flat cloth exerts no force in the triangle wind model: drag on each triangle along its normal, docs/SCENE_FILES.md, as does `pile` for the
-// wind; `tear` once its gusts have ripped it free (it lies slack); and `stiff-drape`'s XPBD (32 substeps of one iteration) is iteration-bound: its strain, 3.0e-3, is
-// the same at 400, 4033 and 40330 N/m (docs/STIFF_CLOTH.md), so its stretch slider shows nothing there.
+// The exceptions, from the physics: `falling` lies asleep and flat on the ground (no strain to change; wind
+// parallel to a flat cloth exerts no force in the triangle wind model, drag on each triangle along its normal,
+// docs/SCENE_FILES.md), as does `pile` for the wind; `tear` lies slack once its gusts have ripped it free; and
+// `stiff-drape`'s XPBD (32 substeps of one iteration) is iteration-bound: its strain, 3.0e-3, is the same at
+// 400, 4033 and 40330 N/m (docs/STIFF_CLOTH.md), so its stretch slider shows nothing there.
 #include "run_process.hpp"
 #include "user_session.hpp"
 

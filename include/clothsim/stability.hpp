@@ -38,6 +38,13 @@ struct StabilityLimit {
 
 // For the cloth's current stiffness, masses, damping and integrator.
 StabilityLimit stability_limit(const MassSpring& sim);
+
+// XPBD's stiffness ceiling: the spring stiffness k (N/m) above which one projection per substep h treats a
+// spring as rigid to within 10%. A projection moves the spring's ends by the fraction (w_a + w_b) /
+// (w_a + w_b + alpha) of its violation, alpha = 1 / (k h^2) (Macklin, Mueller & Chentanez 2016, eq. 18), which
+// is 10/11 at k = 10 / ((w_a + w_b) h^2) and nearer 1 above it: there the single pass, not k, sets the
+// stretch, and a stiffer or softer spring projects nearly alike (docs/STIFF_CLOTH.md).
+double xpbd_rigid_stiffness(double inverse_mass_sum, double substep);
 StabilityLimit stability_limit(const Topology& topology, const State& state, const SimulationSettings& settings);
 
 // Substeps per step that keep dt / substeps below `safety` x the critical substep (at least `minimum`,

@@ -6,6 +6,7 @@
 
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
+#include "clothsim/stability.hpp"
 
 #include <imgui.h>
 
@@ -296,6 +297,39 @@ bool named_fields(Scene& edit, AppState& app, std::initializer_list<std::string_
     return changed;
 }
 
+// Under XPBD, a structural stiffness `k` (N/m per spring) above xpbd_rigid_stiffness at this substep projects
+// nearly as a rigid rod: the stretch the user sees is the pass's, and dragging k changes little. Marked "(i)"
+// on the line that shows k (SameLine: nothing below moves), with why and the substeps that would let k show.
+void xpbd_rigid_marker(const AppState& app, double k) {
+    const SimulationSettings& settings = app.sim.settings();
+    if (settings.integration.integrator != Integrator::Xpbd || !(k > 0.0)) return;
+    const Topology& topology = app.sim.topology();
+    const State& state = app.sim.state();
+    if (topology.rows <= 0 || topology.cols <= 0 || state.inverse_mass.empty()) return;
+    // An inner particle: the grid's centre (the heaviest free particles, so the lowest ceiling's bound).
+    const std::size_t centre = static_cast<std::size_t>(topology.rows / 2) * topology.cols + topology.cols / 2;
+    const double w = centre < state.inverse_mass.size() ? state.inverse_mass[centre] : 0.0;
+    const double h = app.sim.substep_length();
+    if (!(w > 0.0) || !(h > 0.0)) return;
+    const double ceiling = xpbd_rigid_stiffness(2.0 * w, h);
+    if (k <= ceiling) return;
+    // k shows once k <= 10 / (2 w h^2): h <= sqrt(10 / (2 w k)).
+    const double substeps = std::ceil(settings.integration.dt / std::sqrt(10.0 / (2.0 * w * k)));
+    ImGui::SameLine();
+    ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1.0f), "(i)");
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("XPBD at %.3g ms substeps projects every structural spring stiffer than %.3g N/m as nearly "
+                          "rigid:\nthe one pass per substep, not the stiffness, sets the stretch here, so changing it "
+                          "shows little.\nAbout %.0f substeps per step would let %.4g N/m show (docs/STIFF_CLOTH.md).",
+                          1e3 * h, ceiling, substeps, k);
+    }
+}
+
+// The softer of the two directions' structural springs (one of them may be 0: the diagonals hold that axis).
+double softest(glm::dvec2 k) {
+    return std::min(k.x > 0.0 ? k.x : k.y, k.y > 0.0 ? k.y : k.x);
+}
+
 // What an edit of the fabric asks for.
 enum class FabricEdit {
     None,
@@ -368,13 +402,16 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
                 if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", k.note.c_str());
                 app.say(k.note);
             }
+            xpbd_rigid_marker(app, softest(k.structural));
             ImGui::TextDisabled("bends %.4g / %.4g N/m; Poisson ratio %.3f / %.3f", k.bending.x, k.bending.y,
                                 k.poisson_uv, k.poisson_vu);
         } catch (const SceneError& e) {
             ImGui::TextWrapped("%s", e.what());
         }
-    } else if (named_fields(edit, app, {"cloth.mass", "springs.structural", "springs.shear", "springs.bending"})) {
-        result = FabricEdit::Live;
+    } else {
+        if (named_fields(edit, app, {"cloth.mass", "springs.structural"})) result = FabricEdit::Live;
+        xpbd_rigid_marker(app, softest(glm::dvec2(edit.settings.springs.structural)));
+        if (named_fields(edit, app, {"springs.shear", "springs.bending"})) result = FabricEdit::Live;
     }
     return result;
 }

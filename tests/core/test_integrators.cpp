@@ -4,6 +4,7 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
+#include "clothsim/stability.hpp"
 #include "collision/colliders.hpp"
 
 #include <catch2/catch.hpp>
@@ -89,6 +90,32 @@ TEST_CASE("integrators XPBD approaches the spring model as the substeps grow", "
         previous = e;
     }
     CHECK(previous < 0.005 * 0.05 * 10);  // under 2.5 mm of the 5 cm swing at 800 substeps per period
+}
+
+TEST_CASE("integrators XPBD treats springs above its rigid stiffness alike: one substep leaves alpha / (w + alpha)"
+          " of the stretch", "[integrators]") {
+    // One spring, its top end pinned, its free end (0.1 kg, w = 10 /kg) 5 cm past its rest length and at rest;
+    // no gravity, no damping. One substep predicts nothing and projects once: the stretch left is
+    // alpha / (w + alpha), alpha = 1 / (k h^2), which is 1/11 at xpbd_rigid_stiffness and 1/101 at 10 times it.
+    const double h = 1e-3, w = 10.0, stretch = 0.05;
+    auto stretch_left = [&](double k) {
+        Scene s = test::chain(2, 0.5f, 0.1f, static_cast<float>(k));
+        s.pins.particles = {{0, 0}};
+        s.settings.forces.gravity = glm::vec3(0.0f);
+        s.settings.springs.damping = 0.0f;
+        s.settings.integration.integrator = Integrator::Xpbd;
+        s.settings.integration.dt = static_cast<float>(h);
+        s.settings.integration.substeps = 1;
+        MassSpring sim = build_simulation(s);
+        sim.set_particle(1, {0.0f, static_cast<float>(-0.5 - stretch), 0.0f}, glm::vec3(0.0f));
+        sim.substep();
+        return (glm::length(glm::dvec3(sim.position(1) - sim.position(0))) - 0.5) / stretch;
+    };
+    const double k = xpbd_rigid_stiffness(w, h);
+    CHECK(k == Approx(1e6));  // 10 / (10 /kg x (1 ms)^2)
+    CHECK(stretch_left(k) == Approx(1.0 / 11.0).epsilon(1e-3));
+    CHECK(stretch_left(10.0 * k) == Approx(1.0 / 101.0).epsilon(1e-2));
+    CHECK(stretch_left(0.1 * k) == Approx(1.0 / 2.0).epsilon(1e-3));  // below it, k shows
 }
 
 TEST_CASE("integrators switching mid-run keeps position and velocity", "[integrators]") {

@@ -143,6 +143,10 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     return limit;
 }
 
+double xpbd_rigid_stiffness(double inverse_mass_sum, double substep) {
+    return 10.0 / (inverse_mass_sum * substep * substep);
+}
+
 StabilityLimit stability_limit(const MassSpring& sim) {
     return stability_limit(sim.topology(), sim.state(), sim.settings());
 }

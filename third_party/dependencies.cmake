@@ -6,6 +6,7 @@ find_package(tomlplusplus 3 REQUIRED)         # libtomlplusplus-dev: scene files
 find_package(nlohmann_json 3 REQUIRED)        # nlohmann-json3-dev: --json output
 find_package(OpenMP REQUIRED COMPONENTS CXX)  # libgomp (with g++): the fast solver's threads
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)  # libeigen3-dev: sparse Cholesky of the projective solver
+find_package(tinyobjloader REQUIRED)          # libtinyobjloader-dev (2.0.0~rc10, versioned "2rc10": no version asked): OBJ meshes of mesh colliders
 
 if(CLOTHSIM_BUILD_APP)
   find_package(CLI11 2 REQUIRED)              # libcli11-dev: command-line parsing

@@ -9,6 +9,7 @@
 
 #include "clothsim/shapes/box.hpp"
 #include "clothsim/shapes/cylinder.hpp"
+#include "clothsim/shapes/mesh.hpp"
 #include "clothsim/shapes/plane.hpp"
 #include "clothsim/shapes/sphere.hpp"
 
@@ -22,7 +23,7 @@
 namespace clothsim {
 
 // The registered kinds; a scene file's `kind` names one of them (each kind's kName).
-using ColliderShape = std::variant<SphereCollider, BoxCollider, CylinderCollider, PlaneCollider>;
+using ColliderShape = std::variant<SphereCollider, BoxCollider, CylinderCollider, PlaneCollider, MeshCollider>;
 inline constexpr std::size_t kColliderKindCount = std::variant_size_v<ColliderShape>;
 
 // One object: its shape, its friction and whether it collides now (the panel switches one off without losing it).
@@ -38,7 +39,7 @@ struct Collider {
     std::size_t kind() const { return shape.index(); }
 };
 
-// The kinds' names in registration order ("sphere", "box", "cylinder", "plane").
+// The kinds' names in registration order ("sphere", "box", "cylinder", "plane", "mesh").
 constexpr std::array<std::string_view, kColliderKindCount> collider_kind_names() {
     return []<std::size_t... I>(std::index_sequence<I...>) {
         return std::array<std::string_view, kColliderKindCount>{std::variant_alternative_t<I, ColliderShape>::kName...};

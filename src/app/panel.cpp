@@ -5,6 +5,7 @@
 #include "layout.hpp"
 
 #include "clothsim/material.hpp"
+#include "clothsim/mesh_file.hpp"
 #include "clothsim/overloaded.hpp"
 #include "clothsim/stability.hpp"
 
@@ -675,9 +676,43 @@ void integration_section(Scene& edit, AppState& app) {
 
 // One collider's rows: its fields as drags (clamped to their range), each with its tooltip. Returns true when
 // the user changed one.
-bool collider_rows(Collider& collider) {
+// A mesh collider's file, typed and confirmed with Enter: read at once (beside the scene file, else bundled);
+// one that does not load keeps the mesh there was and says why.
+bool mesh_file_row(Collider& collider, const ColliderField& f, AppState& app) {
+    auto* mesh = std::get_if<MeshCollider>(&collider.shape);
+    if (!mesh) return false;
+    char buffer[512];
+    std::snprintf(buffer, sizeof buffer, "%s", mesh->file.c_str());
+    if (!ImGui::InputText("file", buffer, sizeof buffer, ImGuiInputTextFlags_EnterReturnsTrue)) {
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("%s\n%s triangles; type another and press Enter to load it", std::string(f.help).c_str(),
+                              mesh->mesh ? std::to_string(mesh->mesh->triangles().size()).c_str() : "no");
+        }
+        return false;
+    }
+    std::error_code ec;
+    const std::filesystem::path source(app.scene_source);
+    const std::filesystem::path directory = std::filesystem::is_regular_file(source, ec) ? source.parent_path()
+                                                                                          : std::filesystem::path();
+    MeshCollider loaded = *mesh;
+    loaded.file = buffer;
+    try {
+        load_collider_mesh(loaded, directory);
+    } catch (const SceneError& e) {
+        app.say(std::string("mesh not loaded: ") + e.what(), true);
+        return false;
+    }
+    *mesh = std::move(loaded);
+    return true;
+}
+
+bool collider_rows(Collider& collider, AppState& app) {
     bool changed = false;
     for (const ColliderField& f : collider_fields(collider)) {
+        if (std::holds_alternative<std::string*>(f.ref)) {
+            changed |= mesh_file_row(collider, f, app);
+            continue;
+        }
         std::string label(f.name);
         if (!f.unit.empty()) label += " (" + std::string(f.unit) + ")";
         const auto lo = static_cast<float>(f.min), hi = static_cast<float>(f.max);
@@ -717,7 +752,7 @@ void colliders_section(Scene& edit, AppState& app) {
         if (ImGui::SmallButton("remove")) removed = i;
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("remove this collider from the scene");
         if (open) {
-            collider_rows(shapes[i]);
+            collider_rows(shapes[i], app);
             ImGui::TreePop();
         }
         ImGui::PopID();

@@ -1,5 +1,9 @@
 #include "meshes.hpp"
 
+#include "clothsim/triangle_mesh.hpp"
+
+#include <glm/geometric.hpp>
+
 #include <cmath>
 #include <numbers>
 
@@ -105,6 +109,26 @@ MeshData make_ground(float half_size) {
         m.uvs.emplace_back(c * half_size);
     }
     m.indices = {0, 1, 2, 0, 2, 3};
+    return m;
+}
+
+MeshData make_collider_mesh(const TriangleMesh& mesh) {
+    MeshData m;
+    const std::size_t n = mesh.triangles().size();
+    m.positions.reserve(3 * n);
+    m.normals.reserve(3 * n);
+    m.uvs.assign(3 * n, glm::vec2(0.0f));
+    m.indices.reserve(3 * n);
+    const double kSmooth = 0.8660254037844387;  // cos 30 degrees
+    for (std::size_t t = 0; t < n; ++t) {
+        const glm::dvec3 face = mesh.face_normals()[t];
+        for (std::uint32_t v : mesh.triangles()[t]) {
+            const glm::dvec3 smooth = mesh.vertex_normals()[v];
+            m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+            m.positions.push_back(glm::vec3(mesh.vertices()[v]));
+            m.normals.push_back(glm::vec3(glm::dot(smooth, face) > kSmooth ? smooth : face));
+        }
+    }
     return m;
 }
 

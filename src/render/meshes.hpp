@@ -1,4 +1,5 @@
-// Geometry of the static shapes (sphere, cube, cylinder, ground), built on the CPU and uploaded once.
+// Geometry of the static shapes (sphere, cube, cylinder, ground, a mesh collider's triangles), built on the CPU
+// and uploaded once.
 #pragma once
 
 #include <glm/vec2.hpp>
@@ -26,5 +27,9 @@ MeshData make_cube();
 MeshData make_cylinder(int slices);
 // A square in the y = 0 plane, `half_size` metres from the centre to each edge, facing +y.
 MeshData make_ground(float half_size);
+// A mesh collider's triangles (clothsim/triangle_mesh.hpp), three vertices each: smooth (the mesh's
+// angle-weighted vertex normal) where that normal is within 30 degrees of the face's, flat across sharper edges.
+class TriangleMesh;
+MeshData make_collider_mesh(const TriangleMesh& mesh);
 
 }  // namespace clothsim

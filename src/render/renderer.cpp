@@ -64,7 +64,12 @@ glm::vec4 kind_color(SpringKind kind) {
 
 // Where a collider's unit mesh (meshes.hpp) stands: scaled, then moved (shape.hpp's ShapeDrawing).
 glm::mat4 model_of(const ShapeDrawing& d) {
-    return glm::scale(glm::translate(glm::mat4(1.0f), d.center), d.scale);
+    glm::mat4 model = glm::translate(glm::mat4(1.0f), d.center);
+    // Turned about x, then y, then z (shapes/mesh.hpp: R = Rz Ry Rx).
+    model = glm::rotate(model, glm::radians(d.rotation.z), glm::vec3(0.0f, 0.0f, 1.0f));
+    model = glm::rotate(model, glm::radians(d.rotation.y), glm::vec3(0.0f, 1.0f, 0.0f));
+    model = glm::rotate(model, glm::radians(d.rotation.x), glm::vec3(1.0f, 0.0f, 0.0f));
+    return glm::scale(model, d.scale);
 }
 
 }  // namespace
@@ -236,15 +241,27 @@ void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_
         const ShapeDrawing d = drawing(collider);
         if (!collider.enabled || d.mesh == UnitMesh::Plane) continue;  // the floor casts no shadow
         shadow_.set("u_model", model_of(d));
-        mesh_of(d.mesh).draw();
+        mesh_of(d).draw();
     }
 }
 
-const GpuMesh& Renderer::mesh_of(UnitMesh mesh) const {
-    switch (mesh) {
+const GpuMesh& Renderer::mesh_of(const ShapeDrawing& d) {
+    switch (d.mesh) {
         case UnitMesh::Sphere: return sphere_;
         case UnitMesh::Cube: return cube_;
         case UnitMesh::Cylinder: return cylinder_;
+        case UnitMesh::Mesh: {
+            if (!d.triangles) break;
+            const std::size_t count = d.triangles->triangles().size();
+            for (ColliderMesh& m : collider_meshes_) {
+                if (m.source == d.triangles && m.triangles == count) {
+                    m.drawn = true;
+                    return m.mesh;
+                }
+            }
+            collider_meshes_.push_back({d.triangles, count, GpuMesh(make_collider_mesh(*d.triangles)), true});
+            return collider_meshes_.back().mesh;
+        }
         case UnitMesh::Plane: break;
     }
     return ground_;
@@ -311,11 +328,15 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
             case UnitMesh::Sphere: material({0.25f, 0.45f, 0.85f, 1.0f}, nullptr, glm::vec2(1.0f), 0.5f, 48.0f); break;
             case UnitMesh::Cube: material(glm::vec4(1.0f), &crate_, glm::vec2(1.0f), 0.35f, 32.0f); break;
             case UnitMesh::Cylinder: material({0.30f, 0.62f, 0.38f, 1.0f}, nullptr, glm::vec2(1.0f), 0.45f, 40.0f); break;
+            case UnitMesh::Mesh: material({0.72f, 0.60f, 0.46f, 1.0f}, nullptr, glm::vec2(1.0f), 0.3f, 32.0f); break;
             case UnitMesh::Plane: break;
         }
         lit_.set("u_model", model_of(d));
-        mesh_of(d.mesh).draw();
+        mesh_of(d).draw();
     }
+    // A mesh no collider drew this frame (removed, or its scene replaced) leaves the GPU.
+    std::erase_if(collider_meshes_, [](const ColliderMesh& m) { return !m.drawn; });
+    for (ColliderMesh& m : collider_meshes_) m.drawn = false;
     if (!input.view.wireframe && (!input.sim.topology().triangles.empty() || input.sim.surface().split())) {
         material(input.view.texture ? glm::vec4(1.0f) : glm::vec4(0.80f, 0.36f, 0.26f, 1.0f),
                  input.view.texture ? &fabric_ : nullptr, cloth_uv_scale_, 0.08f, 12.0f);

@@ -86,7 +86,9 @@ private:
     void draw_shadow_map(const RenderInput& input, const glm::mat4& light_view_projection);
     void draw_lit(const RenderInput& input, const glm::mat4& view_projection, const glm::mat4& light_view_projection);
     void draw_debug(const RenderInput& input, const glm::mat4& view_projection);
-    const GpuMesh& mesh_of(UnitMesh mesh) const;  // a collider's unit mesh (shapes/shape.hpp)
+    // A collider's mesh (shapes/shape.hpp): a unit mesh, or a mesh collider's triangles, uploaded at its first
+    // draw and dropped once a frame no longer draws it.
+    const GpuMesh& mesh_of(const ShapeDrawing& d);
 
     gl::Shader lit_;
     gl::Shader shadow_;
@@ -101,6 +103,13 @@ private:
     GpuMesh cube_;
     GpuMesh cylinder_;
     GpuMesh ground_;
+    struct ColliderMesh {
+        const TriangleMesh* source;
+        std::size_t triangles;
+        GpuMesh mesh;
+        bool drawn;  // in the frame being drawn
+    };
+    std::vector<ColliderMesh> collider_meshes_;
     // The cloth as drawn: the CPU copy (positions_, normals_) and the GPU mesh made from that copy. Only
     // sync_cloth writes them, all together, so the copy, the mesh and the stamp always describe one cloth.
     std::optional<GpuMesh> cloth_;

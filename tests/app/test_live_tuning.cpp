@@ -264,6 +264,9 @@ TEST_CASE("live tuning: stiff-drape takes wind and damping (its XPBD strain is i
 TEST_CASE("live tuning: stiff-hanging takes wind, damping and stretch while it runs", "[every-scene]") {
     tune_live("stiff-hanging", {});
 }
+TEST_CASE("live tuning: tablecloth takes wind, damping and stretch while it runs", "[every-scene]") {
+    tune_live("tablecloth", {});
+}
 TEST_CASE("live tuning: tear takes wind, damping and stretch while it runs (unless it has torn free)", "[every-scene]") {
     tune_live("tear", {.may_tear_free = true});
 }

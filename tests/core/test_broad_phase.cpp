@@ -4,6 +4,7 @@
 #include "support.hpp"
 
 #include "simulation/mass_spring_internals.hpp"
+#include "clothsim/mesh_shapes.hpp"
 #include "collision/broad_phase.hpp"
 #include "collision/colliders.hpp"
 #include "clothsim/scene.hpp"
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -598,6 +600,38 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cylinder would mov
     check_coverage(tally);
 }
 
+TEST_CASE("broad_phase may_touch never rejects a particle a mesh would move", "[broad_phase]") {
+    // An icosphere mesh (1280 triangles), turned, scaled and moved at random; particles near its surface.
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> radius(0.05f, 2.0f), thickness(0.0f, 0.02f), angle(-180.0f, 180.0f);
+    const auto ball = std::make_shared<const TriangleMesh>(icosphere(1.0, 3));
+    Tally tally;
+    std::uniform_int_distribution<std::size_t> triangle(0, ball->triangles().size() - 1);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int trial = 0; trial < kTrials; ++trial) {
+        MeshCollider mesh;
+        mesh.mesh = ball;
+        mesh.scale = radius(rng);
+        mesh.position = random_vec(rng, pick_scale(rng));
+        mesh.rotation = {angle(rng), angle(rng), angle(rng)};
+        const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
+        // A point on a random triangle, moved along its normal by the thickness and a small offset.
+        const std::size_t k = triangle(rng);
+        const auto& v = ball->vertices();
+        const auto& tri = ball->triangles()[k];
+        double a = unit(rng), b = unit(rng);
+        if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
+        const PlacedMesh at = placed(mesh);
+        const glm::dvec3 on = at.to_world(v[tri[0]] + a * (v[tri[1]] - v[tri[0]]) + b * (v[tri[2]] - v[tri[0]]));
+        const glm::vec3 p = glm::vec3(on + at.rotation * ball->face_normals()[k] * double(t + offset(rng)));
+        check_conservative(Collider{mesh, 0.4f, true}, t, p, rng, tally);
+    }
+    // The mesh's test is as loose as its leaf boxes (a few triangles each): it rejects far boxes, not near ones.
+    INFO("rejected " << tally.rejected << ", accepted " << tally.accepted << ", moved " << tally.moved);
+    CHECK(tally.rejected > kTrials / 20);
+    CHECK(tally.moved > kTrials / 4);
+}
+
 TEST_CASE("broad_phase may_touch never rejects a particle the ground would move", "[broad_phase]") {
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> thickness(0.0f, 0.02f);
@@ -613,6 +647,17 @@ TEST_CASE("broad_phase may_touch never rejects a particle the ground would move"
     check_coverage(tally);
 }
 
+namespace {
+// A mesh collider: an icosphere of radius 0.15 m (1280 triangles) at (0.2, 0.5, -0.25), turned 20 degrees about y.
+MeshCollider ball_mesh() {
+    MeshCollider m;
+    m.mesh = std::make_shared<const TriangleMesh>(icosphere(0.15, 3));
+    m.position = {0.2f, 0.5f, -0.25f};
+    m.rotation = {0.0f, 20.0f, 0.0f};
+    return m;
+}
+}  // namespace
+
 TEST_CASE("broad_phase collide_stage with culling moves every particle exactly as testing them all", "[broad_phase]") {
     ColliderSettings colliders;
     colliders.shapes = {
@@ -620,6 +665,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
         Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
         Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},  // on the ground too
         Collider{PlaneCollider{0.0f}, 0.5f, true},
+        Collider{ball_mesh(), 0.3f, true},
     };
     colliders.thickness = 0.005f;
 
@@ -684,6 +730,7 @@ TEST_CASE("broad_phase collide_stage shared by threads moves every particle exac
         Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
         Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},
         Collider{PlaneCollider{0.0f}, 0.5f, true},
+        Collider{ball_mesh(), 0.3f, true},
     };
     colliders.thickness = 0.005f;
     // Enough particles for the stage to share its blocks among threads, in the cloth's order (blocks along x).

@@ -126,7 +126,7 @@ TEST_CASE("stepper every bundled scene runs bit-identically to the recorded posi
 }
 
 // Every scene file the project holds, stepped as loaded and with each other path and contact model: hashes
-// recorded before the colliders became a list, so both scene-file forms must load into the same contacts in
+// recorded before the colliders became a list (the mesh scene's when meshes came), so both scene-file forms must load into the same contacts in
 // the same order. A refactor that changes one is a change of the physics.
 namespace {
 
@@ -150,6 +150,11 @@ constexpr RecordedFile kRecordedFiles[] = {
     {"scene_every_collider.toml", "colliders.contact=penalty", 60, 0x34b8a72981c5f1a0ull},
     {"scene_every_collider.toml", "integration.integrator=xpbd", 60, 0xbc6a8e9ec06b4b7aull},
     {"scene_every_collider.toml", "integration.integrator=implicit-euler", 30, 0xb29d1ef0b3b5135aull},
+    // A mesh collider (recorded when meshes came): the same contacts on every path and thread count.
+    {"tablecloth", "", 40, 0x954756d0b4ac43f2ull},
+    {"tablecloth", "solver.threads=2", 40, 0x954756d0b4ac43f2ull},
+    {"tablecloth", "solver.method=textbook", 40, 0x954756d0b4ac43f2ull},
+    {"tablecloth", "solver.broad_phase=false", 40, 0x954756d0b4ac43f2ull},
 };
 
 }  // namespace

@@ -13,6 +13,8 @@
 //   bool may_touch(const XCollider&, float thickness, const Box& box);         conservative broad-phase test
 //   Box bounds(const XCollider&);                                              the solid's box
 //   ShapeDrawing drawing(const XCollider&);                                    a unit mesh and its placement
+//   placed(const XCollider&, thickness) (optional): what the queries take, made once per collision stage
+//   sweeps_from_shell(const placed form&) (optional): swept_hit also for paths that start in the shell
 //
 // The contact model is the same for every kind (colliders.hpp): the particle is moved out along `normal` by
 // `depth`, with Coulomb friction; penalty contact pushes it with a force of the depth instead.
@@ -24,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <string_view>
 #include <variant>
 
@@ -49,15 +52,32 @@ struct SweptHit {
 
 // The unit meshes the renderer holds, and where one stands for a shape: scaled by `scale`, moved to `center`
 // (the plane: a large floor at center.y).
-enum class UnitMesh { Sphere, Cube, Cylinder, Plane };
+// A mesh collider draws its own triangles (`triangles`), turned by `rotation` (degrees about x, y, z).
+enum class UnitMesh { Sphere, Cube, Cylinder, Plane, Mesh };
+class TriangleMesh;
 struct ShapeDrawing {
     UnitMesh mesh;
     glm::vec3 center;
     glm::vec3 scale;
+    glm::vec3 rotation{0.0f};
+    const TriangleMesh* triangles = nullptr;
 };
 
+// What the collision stage queries, particle by particle: the shape itself, or (shapes/mesh.hpp) a form with
+// what every query would compute again made once.
+template <class Shape>
+const Shape& placed(const Shape& shape, float /*thickness*/ = 0.0f) {
+    return shape;
+}
+// Whether swept_hit may be asked for a path that starts in the thickness shell: a thin shape (a mesh) can be
+// passed through from there in one substep; the analytic shapes leave that case to the depth test.
+template <class Shape>
+constexpr bool sweeps_from_shell(const Shape&) {
+    return false;
+}
+
 // A field of a shape, as scene files, --set and the panel name it within its [[colliders.shapes]] entry.
-using ShapeValue = std::variant<float*, glm::vec3*>;
+using ShapeValue = std::variant<float*, glm::vec3*, std::string*>;
 template <class Shape>
 struct ShapeField {
     std::string_view name;

@@ -41,8 +41,9 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
                                          : glm::dot(motion, motion) > reach * reach;
         if (may_have_passed) {
             const Vec p1 = state.position.get(i), p0 = p1 - motion;
-            const auto hit = contact(shape, p0, thickness).depth > T(0) ? std::nullopt
-                                                                          : swept_hit(shape, p0, p1, thickness);
+            const auto hit = !sweeps_from_shell(shape) && contact(shape, p0, thickness).depth > T(0)
+                                 ? std::nullopt
+                                 : swept_hit(shape, p0, p1, thickness);
             if (hit) {
                 const Vec entry = p0 + hit->t * motion;
                 deepest = std::max(deepest, glm::length(p1 - entry));
@@ -72,12 +73,13 @@ template <class Shape>
 long long collide_blocks(State& state, const Shape& shape, float friction, float thickness, bool broad_phase,
                          CollisionBlocks& blocks, const Box& cloth, std::size_t kind, int threads, StepProfile* profile) {
     // First the whole cloth (`cloth` holds it): a collider out of its reach costs this one test; then each
-    // block's box.
-    const bool whole_cloth = !broad_phase || may_touch(shape, thickness, cloth);
+    // block's box. `at`: the shape as its queries take it (shape.hpp: placed).
+    decltype(auto) at = placed(shape, thickness);
+    const bool whole_cloth = !broad_phase || may_touch(at, thickness, cloth);
     blocks.tested.clear();
     std::size_t particles = 0;
     for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
-        if (broad_phase && !may_touch(shape, thickness, blocks.boxes[k])) continue;
+        if (broad_phase && !may_touch(at, thickness, blocks.boxes[k])) continue;
         blocks.tested.push_back(static_cast<std::uint32_t>(k));
         particles += blocks.start[k + 1] - blocks.start[k];
     }
@@ -90,7 +92,7 @@ long long collide_blocks(State& state, const Shape& shape, float friction, float
     auto test = [&](long long t) {
         const std::size_t k = blocks.tested[t];
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
-        const float moved = static_cast<float>(collide_shape(state, shape, double(friction), double(thickness), begin, end));
+        const float moved = static_cast<float>(collide_shape(state, at, double(friction), double(thickness), begin, end));
         if (moved > 0.0f && broad_phase) {
             // Grow the box by the farthest push (and a rounding margin) instead of recomputing it: still
             // conservative for the next collider, and O(1).
@@ -131,7 +133,7 @@ void collide_all(State& state, const ColliderSettings& colliders, std::size_t be
 
 void collide(State& state, const Collider& collider, float thickness, std::size_t begin, std::size_t end) {
     std::visit([&](const auto& shape) {
-        collide_shape(state, shape, double(collider.friction), double(thickness), begin, std::min(end, state.size()));
+        collide_shape(state, placed(shape, thickness), double(collider.friction), double(thickness), begin, std::min(end, state.size()));
     }, collider.shape);
 }
 

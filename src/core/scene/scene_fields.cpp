@@ -311,6 +311,10 @@ void validate(const Scene& scene) {
                                      " = ", format_value(f), " is out of range; allowed: ", describe_allowed(f)));
             }
         }
+        if (const auto* mesh = std::get_if<MeshCollider>(&collider.shape); mesh && !mesh->mesh) {
+            throw SceneError(cat("colliders.shapes[", std::to_string(i), "] (mesh): file = \"", mesh->file,
+                                 "\" holds no mesh; allowed: a Wavefront OBJ file that loads"));
+        }
     }
     auto check_radius = [&](float radius, const std::string& what) {
         if (!(radius >= 0.0f && radius <= static_cast<float>(kMaxPinRadius))) {

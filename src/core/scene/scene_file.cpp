@@ -3,6 +3,7 @@
 #include "clothsim/scene.hpp"
 
 #include "clothsim/data_dirs.hpp"
+#include "clothsim/mesh_file.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
@@ -380,9 +381,30 @@ std::string collider_field_names(Collider& collider) {
     return list;
 }
 
+void load_collider_fields(Collider& collider, const toml::table& table, const std::string& name, std::string_view source);
+
 // The fields of one collider from a table (a [[colliders.shapes]] entry or a first-form section), `name` its
-// dotted name in messages. `kind` is read by the caller.
+// dotted name in messages, and a mesh's triangles. `kind` is read by the caller.
 void load_collider(Collider& collider, const toml::table& table, const std::string& name, std::string_view source) {
+    load_collider_fields(collider, table, name, source);
+    // A mesh's file, beside the scene file (source names it) or bundled.
+    if (auto* mesh = std::get_if<MeshCollider>(&collider.shape)) {
+        const toml::node* file = table.get("file");
+        const std::string at = file ? where(source, *file) : std::string(source);
+        if (!file) throw SceneError(at + ": " + name + ".file is missing; allowed: the path of a Wavefront OBJ file");
+        std::error_code ec;
+        const std::filesystem::path scene_path(source);
+        const std::filesystem::path directory =
+            std::filesystem::is_regular_file(scene_path, ec) ? scene_path.parent_path() : std::filesystem::path();
+        try {
+            load_collider_mesh(*mesh, directory);
+        } catch (const SceneError& e) {
+            throw SceneError(at + ": " + name + ".file = \"" + mesh->file + "\": " + e.what());
+        }
+    }
+}
+
+void load_collider_fields(Collider& collider, const toml::table& table, const std::string& name, std::string_view source) {
     for (auto&& [key, node] : table) {
         if (key.str() == "kind") continue;
         const std::string field_name = name + "." + std::string(key.str());
@@ -627,6 +649,18 @@ void apply_override(Scene& scene, std::string_view assignment) {
                          (rejection.why.empty() ? "; allowed: " + allowed : ": " + rejection.why));
     }
     if (field) note_field_set(candidate, key);
+    // A mesh collider given another file reads it (relative to the working directory, then bundled).
+    if (collider_field && collider_field->name == "file") {
+        for (Collider& c : candidate.settings.colliders.shapes) {
+            auto* mesh = std::get_if<MeshCollider>(&c.shape);
+            if (!mesh || &mesh->file != std::get<std::string*>(collider_field->ref)) continue;
+            try {
+                load_collider_mesh(*mesh, {});
+            } catch (const SceneError& e) {
+                throw SceneError(source + ": " + e.what());
+            }
+        }
+    }
     try {
         validate(candidate);
         derive_springs(candidate);

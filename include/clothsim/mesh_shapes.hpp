@@ -1,0 +1,32 @@
+// Closed triangle meshes the project makes itself: the bundled objects (clothsim-make-meshes writes them to
+// assets/meshes) and the meshes the tests and benchmarks compare with the analytic shapes. Every one is
+// closed and oriented outward (TriangleMesh::closed, winding number 1 inside).
+#pragma once
+
+#include "clothsim/triangle_mesh.hpp"
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include <vector>
+
+namespace clothsim {
+
+// A sphere of `radius` about the origin: an icosahedron's faces split `subdivisions` times, each into four,
+// the new vertices pushed onto the sphere: 20 x 4^subdivisions triangles (4: 5120, 6: 81920).
+TriangleMesh icosphere(double radius, int subdivisions);
+
+// An axis-aligned box of edge lengths `size` centred on the origin: two triangles per face.
+TriangleMesh box_mesh(glm::dvec3 size);
+
+// A surface of revolution about the y axis: the profile (radius, height) from a point on the axis to
+// another, each point a ring of vertices (`slices` at the widest, fewer in proportion to the radius, 12 at
+// least) zipped to the next, every face turned outward (away from the axis side of the profile). Closed when
+// both ends lie on the axis.
+TriangleMesh lathe(const std::vector<glm::dvec2>& profile, int slices);
+
+// A round pedestal table (the `tablecloth` scene's): a top of radius 0.5 m, 0.76 m high, with a rim
+// rounded to a radius of 2 cm, on a column and a round foot, standing on y = 0. One closed surface of revolution.
+TriangleMesh round_table();
+
+}  // namespace clothsim

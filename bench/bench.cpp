@@ -192,6 +192,7 @@ int main(int argc, char** argv) {
     realtime->add_option("--threads", rt.threads, "solver.threads of the runs")->delimiter(',');
     realtime->add_option("--repeats", rt.repeats, "Interleaved runs per case (median)")->check(CLI::Range(1, 50));
     realtime->add_option("--csv", rt.csv, "Write the table as CSV");
+    realtime->add_option("--scenes", rt.scenes, "Only these bundled scenes")->delimiter(',');
     bench::ContentionOptions ct;
     CLI::App* contention = app.add_subcommand(
         "contention", "Each threaded path with 0, 1 and 2 busy processes beside it, at 1, 2 and the default threads");

@@ -51,7 +51,7 @@ Run run_scene(const Scene& scene, double duration) {
 }  // namespace
 
 int run_realtime(const RealtimeOptions& options) {
-    const std::vector<std::string> names = bundled_scene_names();
+    const std::vector<std::string> names = options.scenes.empty() ? bundled_scene_names() : options.scenes;
     // (scene, threads) -> the repeats' figures; the repeats go round every case before the next repeat, so a
     // passing load touches every case alike.
     std::map<std::pair<std::string, int>, std::vector<Run>> runs;

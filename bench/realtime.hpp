@@ -12,6 +12,7 @@ struct RealtimeOptions {
     std::vector<int> threads{1, 2};    // solver.threads of the runs
     int repeats = 3;                   // runs per case, interleaved (the median is reported)
     std::string csv;                   // output CSV
+    std::vector<std::string> scenes;   // only these bundled scenes (empty: all)
 };
 
 int run_realtime(const RealtimeOptions& options);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <string_view>
 
 namespace clothsim {
@@ -17,10 +18,12 @@ namespace clothsim {
 inline constexpr std::uintmax_t kMaxMeshFileBytes = 256ull << 20;
 
 // The mesh in `path`. Throws SceneError naming the file, and the line where there is one: a file that is
-// missing, unreadable, a directory, larger than kMaxMeshFileBytes or not text; a vertex without three finite
-// numbers; a face with fewer than three vertices or an index out of range; no triangles; more than
-// kMaxMeshTriangles.
+// missing, unreadable, a directory or not a regular file, larger than kMaxMeshFileBytes or not text; a vertex
+// without three finite numbers, or beyond kMaxMeshCoordinate; a face with fewer than three vertices or an
+// index out of range; no triangles; more than kMaxMeshTriangles.
 std::shared_ptr<const TriangleMesh> read_mesh_file(const std::filesystem::path& path);
+// The same from the file's text, `name` in the messages.
+std::shared_ptr<const TriangleMesh> parse_mesh_text(std::string_view text, const std::string& name);
 
 // Writes `mesh` as OBJ (v and f lines), `comment` first as # lines. Throws SceneError.
 void write_mesh_file(const TriangleMesh& mesh, const std::filesystem::path& path, std::string_view comment);

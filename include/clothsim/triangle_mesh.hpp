@@ -31,6 +31,8 @@ namespace clothsim {
 // The most triangles a mesh may have (docs/SCENE_FILES.md): 2 million, 40 times the largest bundled mesh; the
 // hierarchy and normals then take about 400 MB.
 inline constexpr std::size_t kMaxMeshTriangles = 2'000'000;
+// The largest coordinate magnitude a mesh may have, in its own units: a million (a kilometre in millimetres).
+inline constexpr double kMaxMeshCoordinate = 1e6;
 
 // Cells of edge `cell` from `origin`, `size` of them per axis; cell (i, j, k)'s triangles are
 // triangles[start[c] .. start[c + 1]) with c = i + size.x (j + size.y k), in increasing index. A triangle is
@@ -48,7 +50,7 @@ public:
     using Triangle = std::array<std::uint32_t, 3>;  // vertex indices, counter-clockwise seen from outside
 
     // Throws std::invalid_argument naming the problem: no triangles, more than kMaxMeshTriangles, an index out
-    // of range, a coordinate that is not finite.
+    // of range, a coordinate that is not finite or beyond kMaxMeshCoordinate.
     TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangle> triangles);
 
     const std::vector<glm::dvec3>& vertices() const { return vertices_; }

@@ -80,6 +80,10 @@ TEST_CASE("mesh file a bad file gets one message naming the file, and the line w
                       Contains("binary.obj: not a text file"));
     CHECK_THROWS_WITH(read_mesh_file(dir.write("scene.obj", "name = \"hanging\"\n[cloth]\nrows = 8\n")),
                       Contains("scene.obj: no triangles"));
+    CHECK_THROWS_WITH(read_mesh_file(dir.write("far.obj", "v 0 0 0\nv 2e6 0 0\nv 0 1 0\nf 1 2 3\n")),
+                      Contains("far.obj:2: coordinate 1 is 2e6; allowed: within +-1e6"));
+    // A device streams without end: refused, not read.
+    CHECK_THROWS_WITH(read_mesh_file("/dev/zero"), Contains("cannot read mesh file '/dev/zero': not a regular file"));
 }
 
 TEST_CASE("mesh file a claim of more triangles than allowed is refused before they are read", "[mesh_file]") {

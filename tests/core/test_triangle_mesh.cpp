@@ -196,3 +196,31 @@ TEST_CASE("triangle mesh refuses no triangles, an index out of range and a coord
     const TriangleMesh one(three, T{{0, 1, 2}});
     CHECK_FALSE(one.closed());  // a sheet
 }
+
+TEST_CASE("triangle mesh contact grid answers as the tree does, and stays bounded for triangles huge beside the band",
+          "[triangle_mesh]") {
+    const TriangleMesh mesh = icosphere(0.3, 4);
+    const auto grid = mesh.contact_grid(0.01);
+    CHECK(mesh.contact_grid(0.01) == grid);  // made once per band
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> coordinate(-0.35, 0.35);
+    int found = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+        const auto by_tree = mesh.nearest(p, 0.01), by_grid = mesh.nearest(p, 0.01, *grid);
+        INFO("point " << k);
+        REQUIRE(by_tree.has_value() == by_grid.has_value());
+        if (!by_tree) continue;
+        ++found;
+        CHECK(by_grid->distance == Approx(by_tree->distance).margin(1e-15));
+        CHECK(by_grid->inside == by_tree->inside);
+    }
+    CHECK(found > 500);
+    // Two triangles a kilometre across and a band of a micrometre: larger cells, not billions of listings.
+    const TriangleMesh huge({{-5e5, 0, -5e5}, {5e5, 0, -5e5}, {5e5, 0, 5e5}, {-5e5, 0, 5e5}}, {{0, 2, 1}, {0, 3, 2}});
+    const auto coarse = huge.contact_grid(1e-6);
+    CHECK(coarse->triangles.size() <= 16'000'000u);
+    const auto on = huge.nearest({1.0, 0.5e-6, 2.0}, 1e-6, *coarse);
+    REQUIRE(on);
+    CHECK(on->distance == Approx(0.5e-6));
+}

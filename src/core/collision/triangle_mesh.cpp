@@ -87,6 +87,9 @@ TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangl
         if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
             throw std::invalid_argument("vertex " + std::to_string(i + 1) + " has a coordinate that is not a finite number");
         }
+        if (std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > kMaxMeshCoordinate) {
+            throw std::invalid_argument("vertex " + std::to_string(i + 1) + " has a coordinate beyond 1e6; allowed: within +-1e6");
+        }
     }
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
         for (std::uint32_t v : triangles_[t]) {
@@ -256,32 +259,51 @@ std::shared_ptr<const ContactGrid> TriangleMesh::contact_grid(double band) const
     }
     auto grid = std::make_shared<ContactGrid>();
     grid->band = band;
-    // Cells about half as large as the triangles' edges (and at least two bands): a cell then lists a few of them. At most
-    // kMaxCells cells: larger ones where the mesh's box is large beside its triangles.
-    constexpr double kMaxCells = 4e6;
+    // Cells about half as large as the triangles' edges (and at least two bands): a cell then lists a few of
+    // them. At most kMaxCells cells and kMaxEntries listings: larger cells where the mesh's box is large beside
+    // its triangles, or its triangles large beside the band.
+    constexpr double kMaxCells = 4e6, kMaxEntries = 16e6;
     double edges = 0.0;
     for (const Triangle& t : triangles_) edges += glm::length(vertices_[t[1]] - vertices_[t[0]]);
     const glm::dvec3 lo = this->lo() - glm::dvec3(band), extent = this->hi() - this->lo() + glm::dvec3(2.0 * band);
     double cell = std::max({0.5 * edges / static_cast<double>(triangles_.size()), 2.0 * band, 1e-9});
-    while ((extent.x / cell + 1.0) * (extent.y / cell + 1.0) * (extent.z / cell + 1.0) > kMaxCells) cell *= 1.25;
-    grid->cell = cell;
-    grid->origin = lo;
-    for (int a = 0; a < 3; ++a) grid->size[a] = static_cast<int>(std::floor(extent[a] / cell)) + 1;
-    const std::size_t cells = static_cast<std::size_t>(grid->size[0]) * grid->size[1] * grid->size[2];
-    // Each triangle's cells: its box grown by the band, clamped to the grid. Counted, then filled in order.
-    auto each_cell = [&](std::uint32_t t, auto&& visit) {
+    // Triangle t's cells: its box grown by the band, clamped to the grid (of `size` cells of edge `cell`).
+    std::array<int, 3> size{};
+    auto range = [&](std::uint32_t t, std::array<int, 3>& from, std::array<int, 3>& to) {
         glm::dvec3 tlo(INFINITY), thi(-INFINITY);
         for (std::uint32_t v : triangles_[t]) tlo = glm::min(tlo, vertices_[v]), thi = glm::max(thi, vertices_[v]);
-        std::array<int, 3> from{}, to{};
         for (int a = 0; a < 3; ++a) {
-            from[a] = std::clamp(static_cast<int>(std::floor((tlo[a] - band - lo[a]) / cell)), 0, grid->size[a] - 1);
-            to[a] = std::clamp(static_cast<int>(std::floor((thi[a] + band - lo[a]) / cell)), 0, grid->size[a] - 1);
+            const double top = size[a] - 1;
+            from[a] = static_cast<int>(std::clamp(std::floor((tlo[a] - band - lo[a]) / cell), 0.0, top));
+            to[a] = static_cast<int>(std::clamp(std::floor((thi[a] + band - lo[a]) / cell), 0.0, top));
         }
+    };
+    for (;;) {
+        if ((extent.x / cell + 1.0) * (extent.y / cell + 1.0) * (extent.z / cell + 1.0) > kMaxCells) {
+            cell *= 1.25;
+            continue;
+        }
+        for (int a = 0; a < 3; ++a) size[a] = static_cast<int>(std::floor(extent[a] / cell)) + 1;
+        double entries = 0.0;
+        for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+            std::array<int, 3> from{}, to{};
+            range(t, from, to);
+            entries += double(to[0] - from[0] + 1) * (to[1] - from[1] + 1) * (to[2] - from[2] + 1);
+        }
+        if (entries <= kMaxEntries) break;
+        cell *= 1.25;
+    }
+    grid->cell = cell;
+    grid->origin = lo;
+    grid->size = size;
+    const std::size_t cells = static_cast<std::size_t>(size[0]) * size[1] * size[2];
+    auto each_cell = [&](std::uint32_t t, auto&& visit) {
+        std::array<int, 3> from{}, to{};
+        range(t, from, to);
         for (int k = from[2]; k <= to[2]; ++k) {
             for (int j = from[1]; j <= to[1]; ++j) {
                 for (int i = from[0]; i <= to[0]; ++i) {
-                    visit(static_cast<std::size_t>(i) +
-                          static_cast<std::size_t>(grid->size[0]) * (j + static_cast<std::size_t>(grid->size[1]) * k));
+                    visit(static_cast<std::size_t>(i) + static_cast<std::size_t>(size[0]) * (j + static_cast<std::size_t>(size[1]) * k));
                 }
             }
         }

@@ -55,6 +55,9 @@ std::size_t check_lines(std::string_view text, const std::string& name) {
                 if (token.empty() || stop != token.c_str() + token.size() || !std::isfinite(value)) {
                     fail("a vertex needs three finite numbers; coordinate " + std::to_string(k + 1) + " is '" + token + "'");
                 }
+                if (std::fabs(value) > kMaxMeshCoordinate) {
+                    fail("coordinate " + std::to_string(k + 1) + " is " + token + "; allowed: within +-1e6 (mesh units)");
+                }
             }
             ++vertices;
         } else if (command == "f") {
@@ -94,22 +97,31 @@ std::shared_ptr<const TriangleMesh> read_mesh_file(const std::filesystem::path& 
     if (std::filesystem::is_directory(path, ec)) throw SceneError("cannot read mesh file '" + name + "': it is a directory");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw SceneError("cannot read mesh file '" + name + "': " + std::strerror(errno));
+    // A device or a pipe could stream without end: only regular files are read.
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        throw SceneError("cannot read mesh file '" + name + "': not a regular file");
+    }
     const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
     if (!ec && bytes > kMaxMeshFileBytes) {
         throw SceneError(name + ": the file has " + std::to_string(bytes) + " bytes; allowed: at most " +
                          std::to_string(kMaxMeshFileBytes) + " (" + std::to_string(kMaxMeshFileBytes >> 20) + " MB)");
     }
-    std::string text;
-    {
-        std::ostringstream buffer;
-        buffer << in.rdbuf();
-        if (in.bad()) throw SceneError("cannot read mesh file '" + name + "'");
-        text = std::move(buffer).str();
+    // At most one byte past the limit is read, however the file grows meanwhile.
+    std::string text(static_cast<std::size_t>(std::min<std::uintmax_t>(ec ? 0 : bytes, kMaxMeshFileBytes)), '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (in.bad()) throw SceneError("cannot read mesh file '" + name + "'");
+    if (in.peek() != std::char_traits<char>::eof()) {
+        throw SceneError(name + ": the file has more than " + std::to_string(kMaxMeshFileBytes) + " bytes");
     }
+    return parse_mesh_text(text, name);
+}
+
+std::shared_ptr<const TriangleMesh> parse_mesh_text(std::string_view text, const std::string& name) {
     if (text.size() > kMaxMeshFileBytes) {
-        throw SceneError(name + ": the file has more than " + std::to_string(kMaxMeshFileBytes >> 20) + " MB");
+        throw SceneError(name + ": the file has more than " + std::to_string(kMaxMeshFileBytes) + " bytes");
     }
-    if (text.find('\0') != std::string::npos) {
+    if (text.find('\0') != std::string_view::npos) {
         throw SceneError(name + ": not a text file; allowed: a Wavefront OBJ file");
     }
     const std::size_t expected = check_lines(text, name);
@@ -117,7 +129,7 @@ std::shared_ptr<const TriangleMesh> read_mesh_file(const std::filesystem::path& 
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
     std::string warning, error;
-    std::istringstream stream(text);
+    std::istringstream stream{std::string(text)};
     // Materials are not read (the renderer draws every collider in its own look).
     std::istringstream empty;
     tinyobj::MaterialStreamReader none(empty);

@@ -23,10 +23,34 @@ struct Closest {
     int index;  // the vertex or edge
 };
 
+// The point of the three edges of abc closest to p: what is left of a triangle without area.
+Closest closest_on_edges(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    const glm::dvec3 corner[3] = {a, b, c};
+    Closest best{a, Feature::Vertex, 0};
+    double best2 = INFINITY;
+    for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 from = corner[k], along = corner[(k + 1) % 3] - from;
+        const double length2 = glm::dot(along, along);
+        const double t = length2 > 0.0 ? std::clamp(glm::dot(p - from, along) / length2, 0.0, 1.0) : 0.0;
+        const glm::dvec3 q = from + t * along;
+        const double d2 = glm::dot(p - q, p - q);
+        if (d2 < best2) {
+            best2 = d2;
+            best = t <= 0.0 ? Closest{from, Feature::Vertex, k}
+                   : t >= 1.0 ? Closest{corner[(k + 1) % 3], Feature::Vertex, (k + 1) % 3}
+                              : Closest{q, Feature::Edge, k};
+        }
+    }
+    return best;
+}
+
 // The point of triangle abc closest to p (Ericson, "Real-Time Collision Detection", 2005, 5.1.5), by the Voronoi
 // region p lies in.
 Closest closest_on_triangle(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
     const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    // Without area (coincident or collinear corners) the regions below divide by zero: the edges instead.
+    const glm::dvec3 normal = glm::cross(ab, ac);
+    if (!(glm::dot(normal, normal) > 1e-24 * glm::dot(ab, ab) * glm::dot(ac, ac))) return closest_on_edges(p, a, b, c);
     const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) return {a, Feature::Vertex, 0};
     const glm::dvec3 bp = p - b;
@@ -44,7 +68,6 @@ Closest closest_on_triangle(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3
         return {b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b), Feature::Edge, 1};
     }
     const double denom = va + vb + vc;
-    if (!(std::fabs(denom) > 0.0)) return {a, Feature::Vertex, 0};  // degenerate: a line or a point
     const double v = vb / denom, w = vc / denom;
     return {a + ab * v + ac * w, Feature::Face, 0};
 }
@@ -194,7 +217,7 @@ std::uint32_t TriangleMesh::build(std::uint32_t first, std::uint32_t count) {
     const Closest c = closest_on_triangle(p, a, vertices_[tri[1]], vertices_[tri[2]]);
     const glm::dvec3 d = p - c.point;
     const double d2 = glm::dot(d, d);
-    if (found ? d2 >= best2 : d2 > best2) return false;
+    if (found ? !(d2 < best2) : !(d2 <= best2)) return false;  // a NaN is never nearer
     best2 = d2;
     const glm::dvec3 normal = c.feature == Feature::Face     ? face_normals_[t]
                               : c.feature == Feature::Edge   ? edge_normals_[t][c.index]

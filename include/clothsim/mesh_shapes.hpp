@@ -25,8 +25,9 @@ TriangleMesh box_mesh(glm::dvec3 size);
 // both ends lie on the axis.
 TriangleMesh lathe(const std::vector<glm::dvec2>& profile, int slices);
 
-// A round pedestal table (the `tablecloth` scene's): a top of radius 0.5 m, 0.76 m high, with a rim
-// rounded to a radius of 2 cm, on a column and a round foot, standing on y = 0. One closed surface of revolution.
+// A round pedestal table (the `tablecloth` scene's): a top of radius 0.5 m, 0.76 m high and 6 cm thick, with
+// a rim rounded to a radius of 3 cm, on a column and a round foot, standing on y = 0. One closed surface of
+// revolution.
 TriangleMesh round_table();
 
 }  // namespace clothsim

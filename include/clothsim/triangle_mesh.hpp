@@ -10,7 +10,7 @@
 // Contact asks `nearest` within the thickness for every particle near the mesh in every substep: for that,
 // a contact grid (a uniform grid of cells, each listing the triangles within `band` of it: the narrow band of
 // a distance grid, with the exact triangles instead of sampled distances) answers with one cell's few
-// triangles instead of a walk down the tree; the same answer, about 5x sooner (docs/COLLIDERS.md).
+// triangles instead of a walk down the tree; the same answer, about 4x sooner over a table top (docs/COLLIDERS.md).
 // The hierarchy is built once (top-down, split at the median centroid along the box's longest axis; Ericson,
 // "Real-Time Collision Detection", 2005, ch. 6) and never changes: a moving collider moves the query into the
 // mesh's coordinates instead. Immutable after construction, so colliders share one mesh (std::shared_ptr).

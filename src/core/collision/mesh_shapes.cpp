@@ -120,13 +120,14 @@ TriangleMesh round_table() {
         for (int k = 0; k <= steps; ++k) p.push_back({from + (to - from) * k / steps, y});
     };
     flat(0.0, 0.26, 0.0);  // the foot
-    for (glm::dvec2 q : {glm::dvec2{0.27, 0.01}, {0.26, 0.025}, {0.06, 0.04}, {0.035, 0.08}, {0.035, 0.69}, {0.06, 0.715}}) {
+    for (glm::dvec2 q : {glm::dvec2{0.27, 0.01}, {0.26, 0.025}, {0.06, 0.04}, {0.035, 0.08}, {0.035, 0.66}, {0.06, 0.69}}) {
         p.push_back(q);
     }
-    // The top, 4 cm thick: its underside out to the rim, a rim rounded with radius 2 cm, its top back to the axis.
-    const double r = 0.5, rim = 0.02, middle = 0.74;
+    // The top, 6 cm thick: its underside out to the rim, a rim rounded with radius 3 cm (a cloth 4.5 cm between
+    // particles wraps it with chords that sag 6 mm, inside a thickness of 8 mm), its top back to the axis.
+    const double r = 0.5, rim = 0.03, middle = 0.73;
     flat(0.12, r - rim, middle - rim);
-    for (int k = 1; k < 6; ++k) {  // 30 degrees apart: the rim's polygon lies within 0.7 mm of its circle
+    for (int k = 1; k < 6; ++k) {  // 30 degrees apart: the rim's polygon lies within 1 mm of its circle
         const double a = -0.5 * std::numbers::pi + std::numbers::pi * k / 6.0;
         p.push_back({r - rim + rim * std::cos(a), middle + rim * std::sin(a)});
     }

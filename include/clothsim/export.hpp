@@ -8,8 +8,10 @@
 
 namespace clothsim {
 
-// Writes positions, per-vertex UVs and the cloth's triangles; a torn cloth split along its tears (cloth_surface.hpp). Returns false (with `error` set) on failure.
-bool write_obj(const MassSpring& sim, const std::string& path, std::string& error);
+// Writes positions, per-vertex UVs and the cloth's triangles; a torn cloth split along its tears (cloth_surface.hpp).
+// With `colliders`, the cloth is object `cloth` and each enabled collider with a surface follows as its own
+// object, `collider-N-<kind>` (mesh_shapes.hpp: collider_surface). Returns false (with `error` set) on failure.
+bool write_obj(const MassSpring& sim, const std::string& path, std::string& error, bool colliders = false);
 
 // CSV with header `step,time,particle,x,y,z`, one row per particle per recorded step.
 class TrajectoryWriter {

@@ -3,11 +3,13 @@
 // closed and oriented outward (TriangleMesh::closed, winding number 1 inside).
 #pragma once
 
+#include "clothsim/collider.hpp"
 #include "clothsim/triangle_mesh.hpp"
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace clothsim {
@@ -29,5 +31,10 @@ TriangleMesh lathe(const std::vector<glm::dvec2>& profile, int slices);
 // a rim rounded to a radius of 3 cm, on a column and a round foot, standing on y = 0. One closed surface of
 // revolution.
 TriangleMesh round_table();
+
+// A collider's surface as triangles in world coordinates (for `--obj-colliders`): a mesh as placed, a sphere as
+// an icosphere of 1280 triangles, a box, a cylinder of 64 sides; none for a plane (it has no edge) or a kind
+// without a surface here.
+std::optional<TriangleMesh> collider_surface(const Collider& collider);
 
 }  // namespace clothsim

@@ -218,7 +218,7 @@ int finish(const HeadlessOptions& options, const MassSpring& sim, const RunOutco
     }
     if (!options.obj.empty()) {
         std::string error;
-        if (!write_obj(sim, options.obj, error)) {
+        if (!write_obj(sim, options.obj, error, options.obj_colliders)) {
             std::cerr << "clothsim: error: " << error << "\n";
             code = kExitBadInput;
         }

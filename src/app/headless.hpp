@@ -16,6 +16,7 @@ struct HeadlessOptions {
     std::string trajectory;          // CSV path, empty for none
     long long every = 1;             // record the trajectory every K steps
     std::string obj;                 // OBJ path of the final mesh, empty for none
+    bool obj_colliders = false;      // the OBJ holds the colliders too, each its own object
     bool json = false;
     float auto_substeps = 0.0f;      // > 0: pick integration.substeps so the substep is this fraction of dt_crit
     bool guard = false;              // roll back and double the substeps when a step blows up

@@ -110,7 +110,10 @@ void add_flags(CLI::App& app, CommandLine& cl) {
     app.add_option("--every", cl.options.every, "With --trajectory: record every K steps")
         ->transform(number_check({.whole = true, .min = 1, .max = 1e9, .meaning = "steps between rows"}))
         ->needs(trajectory);
-    app.add_option("--obj", cl.options.obj, "Write the final mesh as Wavefront OBJ");
+    CLI::Option* obj = app.add_option("--obj", cl.options.obj, "Write the final mesh as Wavefront OBJ");
+    app.add_flag("--obj-colliders", cl.options.obj_colliders,
+                 "With --obj: write the colliders too, each as its own object after the cloth")
+        ->needs(obj);
     app.add_flag("--json", cl.options.json, "Print one JSON object with the run's figures on stdout");
     app.add_option("--auto-substeps", cl.options.auto_substeps,
                    "Choose integration.substeps so the substep is this fraction of the critical one (the app "

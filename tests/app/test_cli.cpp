@@ -1,6 +1,8 @@
 // The clothsim executable, run as a user would: flags, exit codes (0 ok, 2 bad input, 3 blew up), the
 // --json report, the trajectory CSV and the OBJ mesh.
 #include "clothsim/mass_spring.hpp"
+#include "clothsim/mesh_file.hpp"
+#include "clothsim/mesh_shapes.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
 
@@ -8,6 +10,7 @@
 #include "support.hpp"
 
 #include <catch2/catch.hpp>
+#include <glm/common.hpp>
 #include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
@@ -437,6 +440,42 @@ TEST_CASE("cli: --trajectory into a missing directory exits 2") {
     const std::string path = (dir / "no_such_dir" / "out.csv").string();
     expect_bad_input({"--headless", "--steps", "1", "--trajectory", path}, {path});
     CHECK_FALSE(fs::exists(dir / "no_such_dir"));
+}
+
+TEST_CASE("cli: --obj-colliders writes each collider after the cloth as its own object, in place") {
+    const TempDir dir("obj_colliders");
+    const fs::path obj = dir / "out.obj";
+    const RunResult r = run_clothsim({"--headless", "--scene", "tablecloth", "--steps", "1", "--set", "cloth.rows=4",
+                                      "--set", "cloth.cols=4", "--obj", obj.string(), "--obj-colliders"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    // Objects in order: the cloth, then the table (the plane has no surface to write).
+    std::vector<std::string> objects;
+    std::map<std::string, int> faces;
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    for (const std::string& line : lines_of(read_file(obj))) {
+        if (line.rfind("o ", 0) == 0) objects.push_back(line.substr(2));
+        if (line.rfind("f ", 0) == 0) ++faces[objects.back()];
+        if (line.rfind("v ", 0) == 0 && objects.back() != "cloth") {
+            std::istringstream in(line.substr(2));
+            glm::dvec3 p;
+            in >> p.x >> p.y >> p.z;
+            lo = glm::min(lo, p), hi = glm::max(hi, p);
+        }
+    }
+    CHECK(objects == std::vector<std::string>{"cloth", "collider-0-mesh"});
+    CHECK(faces["cloth"] == 2 * 3 * 3);
+    CHECK(faces["collider-0-mesh"] == static_cast<int>(clothsim::round_table().triangles().size()));
+    CHECK(hi.y == Approx(0.76));  // the table as it stands in the scene
+    CHECK(hi.x == Approx(0.5));
+    CHECK(lo.y == Approx(0.0).margin(1e-9));
+    // The file reads back as one mesh of both, every index in range.
+    CHECK(clothsim::read_mesh_file(obj)->triangles().size() == static_cast<std::size_t>(faces["cloth"] + faces["collider-0-mesh"]));
+    // Without the flag, the cloth alone, as before; the flag alone is refused.
+    const RunResult plain = run_clothsim({"--headless", "--scene", "tablecloth", "--steps", "1", "--obj", obj.string()});
+    REQUIRE(plain.code == 0);
+    CHECK(read_file(obj).find("\no ") == std::string::npos);
+    expect_bad_input({"--headless", "--obj-colliders"}, {"--obj-colliders", "--obj"});
 }
 
 TEST_CASE("cli: --obj into a missing directory exits 2") {

@@ -1,5 +1,7 @@
 #include "clothsim/mesh_shapes.hpp"
 
+#include "clothsim/overloaded.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -133,6 +135,36 @@ TriangleMesh round_table() {
     }
     flat(r - rim, 0.0, middle + rim);
     return lathe(p, 128);  // the top's edge within 0.15 mm of its circle
+}
+
+std::optional<TriangleMesh> collider_surface(const Collider& collider) {
+    // The shape's own mesh about its origin, then moved (and for a mesh turned and scaled) into place.
+    auto moved = [](const TriangleMesh& local, auto&& place) {
+        std::vector<glm::dvec3> v = local.vertices();
+        for (glm::dvec3& p : v) p = place(p);
+        return TriangleMesh(std::move(v), local.triangles());
+    };
+    return std::visit(
+        Overloaded{
+            [&](const SphereCollider& s) -> std::optional<TriangleMesh> {
+                return moved(icosphere(s.radius, 3), [&](glm::dvec3 p) { return p + glm::dvec3(s.center); });
+            },
+            [&](const BoxCollider& b) -> std::optional<TriangleMesh> {
+                return moved(box_mesh(glm::dvec3(b.size)), [&](glm::dvec3 p) { return p + glm::dvec3(b.center); });
+            },
+            [&](const CylinderCollider& c) -> std::optional<TriangleMesh> {
+                const double r = c.radius, h = 0.5 * c.height;
+                return moved(lathe({{0.0, -h}, {r, -h}, {r, h}, {0.0, h}}, 64),
+                             [&](glm::dvec3 p) { return p + glm::dvec3(c.center); });
+            },
+            [&](const MeshCollider& m) -> std::optional<TriangleMesh> {
+                if (!m.mesh) return std::nullopt;
+                const PlacedMesh at = placed(m);
+                return moved(*m.mesh, [&](glm::dvec3 p) { return at.to_world(p); });
+            },
+            [](const auto&) -> std::optional<TriangleMesh> { return std::nullopt; },
+        },
+        collider.shape);
 }
 
 }  // namespace clothsim

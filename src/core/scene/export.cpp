@@ -1,18 +1,22 @@
 #include "clothsim/export.hpp"
 
 #include "clothsim/atomic_file.hpp"
+#include "clothsim/mesh_shapes.hpp"
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace clothsim {
 
-bool write_obj(const MassSpring& sim, const std::string& path, std::string& error) {
+bool write_obj(const MassSpring& sim, const std::string& path, std::string& error, bool colliders) {
     std::ostringstream out;
     const Topology& t = sim.topology();
     out << "# clothsim mesh: " << t.rows << " x " << t.cols << " particles, t = " << sim.time() << " s\n";
     out.precision(9);
+    if (colliders) out << "o cloth\n";
     // A torn cloth is written split along its tears (cloth_surface.hpp): its split vertices follow the particles.
     const ClothSurface& surface = sim.surface();
     std::vector<glm::vec3> vertices = sim.positions();
@@ -38,6 +42,27 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
         out << 'f';
         for (std::uint32_t v : tri) corner(v);
         out << '\n';
+    }
+    if (colliders) {
+        // Each collider after the cloth: its vertices continue the file's numbering; no texture coordinates.
+        std::size_t first = vertices.size() + 1;
+        const std::vector<Collider>& shapes = sim.settings().colliders.shapes;
+        for (std::size_t i = 0; i < shapes.size(); ++i) {
+            if (!shapes[i].enabled) continue;
+            std::optional<TriangleMesh> mesh;
+            try {
+                mesh = collider_surface(shapes[i]);
+            } catch (const std::invalid_argument&) {
+                continue;  // no area to write (a cylinder of radius 0)
+            }
+            if (!mesh) continue;
+            out << "o collider-" << i << '-' << kind_name(shapes[i]) << '\n';
+            for (const glm::dvec3& p : mesh->vertices()) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+            for (const TriangleMesh::Triangle& tri : mesh->triangles()) {
+                out << "f " << tri[0] + first << ' ' << tri[1] + first << ' ' << tri[2] + first << '\n';
+            }
+            first += mesh->vertices().size();
+        }
     }
     if (!write_file_atomically(path, out.str(), error)) {
         error = "OBJ file: " + error;

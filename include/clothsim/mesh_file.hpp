@@ -33,6 +33,10 @@ void write_mesh_file(const TriangleMesh& mesh, const std::filesystem::path& path
 // SceneError listing the places tried.
 std::filesystem::path find_mesh_file(std::string_view file, const std::filesystem::path& scene_directory);
 
+// The folder a scene's mesh files are looked for in first: the directory of `scene_source` when it names a
+// scene file, else none (the working directory: a bundled scene, --set, a scene from text).
+std::filesystem::path scene_file_directory(std::string_view scene_source);
+
 // Reads the mesh a mesh collider's `file` names (find_mesh_file) into `collider.mesh`; throws SceneError.
 struct MeshCollider;
 void load_collider_mesh(MeshCollider& collider, const std::filesystem::path& scene_directory);

@@ -674,8 +674,6 @@ void integration_section(Scene& edit, AppState& app) {
     }
 }
 
-// One collider's rows: its fields as drags (clamped to their range), each with its tooltip. Returns true when
-// the user changed one.
 // A mesh collider's file, typed and confirmed with Enter: read at once (beside the scene file, else bundled);
 // one that does not load keeps the mesh there was and says why.
 bool mesh_file_row(Collider& collider, const ColliderField& f, AppState& app) {
@@ -690,14 +688,10 @@ bool mesh_file_row(Collider& collider, const ColliderField& f, AppState& app) {
         }
         return false;
     }
-    std::error_code ec;
-    const std::filesystem::path source(app.scene_source);
-    const std::filesystem::path directory = std::filesystem::is_regular_file(source, ec) ? source.parent_path()
-                                                                                          : std::filesystem::path();
     MeshCollider loaded = *mesh;
     loaded.file = buffer;
     try {
-        load_collider_mesh(loaded, directory);
+        load_collider_mesh(loaded, scene_file_directory(app.scene_source));
     } catch (const SceneError& e) {
         app.say(std::string("mesh not loaded: ") + e.what(), true);
         return false;
@@ -706,6 +700,8 @@ bool mesh_file_row(Collider& collider, const ColliderField& f, AppState& app) {
     return true;
 }
 
+// One collider's rows: its fields as drags (clamped to their range), each with its tooltip. Returns true when
+// the user changed one.
 bool collider_rows(Collider& collider, AppState& app) {
     bool changed = false;
     for (const ColliderField& f : collider_fields(collider)) {

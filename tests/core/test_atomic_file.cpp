@@ -1,5 +1,6 @@
 // write_file_atomically: the target is the old file or the whole new one, whatever goes wrong.
 #include "clothsim/atomic_file.hpp"
+#include "temp_dir.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -19,17 +20,7 @@ using clothsim::write_file_atomically;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string name = (fs::temp_directory_path() / "clothsim-atomic-XXXXXX").string();
-        path = ::mkdtemp(name.data());
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-};
+using clothsim::test::TempDir;
 
 std::string read(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -45,7 +36,7 @@ int entries(const fs::path& dir) {
 }  // namespace
 
 TEST_CASE("atomic_file writes a new file and replaces an old one, leaving no temporary file", "[atomic_file]") {
-    TempDir dir;
+    TempDir dir("atomic");
     const fs::path target = dir.path / "scene.toml";
     std::string error;
     REQUIRE(write_file_atomically(target, "first\n", error));
@@ -59,7 +50,7 @@ TEST_CASE("atomic_file writes a new file and replaces an old one, leaving no tem
 }
 
 TEST_CASE("atomic_file into a missing directory fails, naming the path and the directory", "[atomic_file]") {
-    TempDir dir;
+    TempDir dir("atomic");
     const fs::path target = dir.path / "missing" / "scene.toml";
     std::string error;
     CHECK_FALSE(write_file_atomically(target, "text", error));
@@ -68,7 +59,7 @@ TEST_CASE("atomic_file into a missing directory fails, naming the path and the d
 }
 
 TEST_CASE("atomic_file refuses a directory or a device as the target and leaves it alone", "[atomic_file]") {
-    TempDir dir;
+    TempDir dir("atomic");
     std::string error;
     CHECK_FALSE(write_file_atomically(dir.path, "text", error));
     CHECK_THAT(error, Contains("is a directory"));
@@ -80,7 +71,7 @@ TEST_CASE("atomic_file refuses a directory or a device as the target and leaves 
 
 TEST_CASE("atomic_file: a write that fails half-way leaves the old file whole and no temporary file",
           "[atomic_file]") {
-    TempDir dir;
+    TempDir dir("atomic");
     const fs::path target = dir.path / "scene.toml";
     {
         std::ofstream(target) << "the old scene\n";

@@ -157,6 +157,12 @@ std::shared_ptr<const TriangleMesh> parse_mesh_text(std::string_view text, const
     }
 }
 
+std::filesystem::path scene_file_directory(std::string_view scene_source) {
+    std::error_code ec;
+    const std::filesystem::path source(scene_source);
+    return std::filesystem::is_regular_file(source, ec) ? source.parent_path() : std::filesystem::path();
+}
+
 void load_collider_mesh(MeshCollider& collider, const std::filesystem::path& scene_directory) {
     collider.mesh = read_mesh_file(find_mesh_file(collider.file, scene_directory));
 }

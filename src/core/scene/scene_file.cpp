@@ -392,12 +392,8 @@ void load_collider(Collider& collider, const toml::table& table, const std::stri
         const toml::node* file = table.get("file");
         const std::string at = file ? where(source, *file) : std::string(source);
         if (!file) throw SceneError(at + ": " + name + ".file is missing; allowed: the path of a Wavefront OBJ file");
-        std::error_code ec;
-        const std::filesystem::path scene_path(source);
-        const std::filesystem::path directory =
-            std::filesystem::is_regular_file(scene_path, ec) ? scene_path.parent_path() : std::filesystem::path();
         try {
-            load_collider_mesh(*mesh, directory);
+            load_collider_mesh(*mesh, scene_file_directory(source));
         } catch (const SceneError& e) {
             throw SceneError(at + ": " + name + ".file = \"" + mesh->file + "\": " + e.what());
         }
@@ -586,6 +582,7 @@ void apply_override(Scene& scene, std::string_view assignment) {
     // (colliders.sphere.radius: the first sphere, added switched off when there is none).
     Scene candidate = scene;
     std::optional<ColliderField> collider_field;
+    Collider* edited = nullptr;  // the collider collider_field belongs to
     if (key.starts_with("colliders.")) {
         const std::string rest = key.substr(std::string_view("colliders.").size());
         const auto dot = rest.find('.');
@@ -611,7 +608,7 @@ void apply_override(Scene& scene, std::string_view assignment) {
         }
         if (collider) {
             for (const ColliderField& f : collider_fields(*collider)) {
-                if (f.name == field_name) collider_field = f;
+                if (f.name == field_name) collider_field = f, edited = collider;
             }
             if (!collider_field) {
                 throw SceneError(source + ": unknown field '" + key + "'; known fields of a " +
@@ -650,15 +647,11 @@ void apply_override(Scene& scene, std::string_view assignment) {
     }
     if (field) note_field_set(candidate, key);
     // A mesh collider given another file reads it (relative to the working directory, then bundled).
-    if (collider_field && collider_field->name == "file") {
-        for (Collider& c : candidate.settings.colliders.shapes) {
-            auto* mesh = std::get_if<MeshCollider>(&c.shape);
-            if (!mesh || &mesh->file != std::get<std::string*>(collider_field->ref)) continue;
-            try {
-                load_collider_mesh(*mesh, {});
-            } catch (const SceneError& e) {
-                throw SceneError(source + ": " + e.what());
-            }
+    if (auto* mesh = edited ? std::get_if<MeshCollider>(&edited->shape) : nullptr; mesh && collider_field->name == "file") {
+        try {
+            load_collider_mesh(*mesh, {});
+        } catch (const SceneError& e) {
+            throw SceneError(source + ": " + e.what());
         }
     }
     try {

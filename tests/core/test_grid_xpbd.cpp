@@ -98,6 +98,8 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         // Three bands of rows and a part of one: the rows that reach into the next band come last.
         {"per-spring hanging, tall", xpbd_scene(per_spring_scene("hanging"), 2 * GridXpbd::kBandRows + 9, 9, 8)},
         {"material hanging, tall", xpbd_scene(material, 3 * GridXpbd::kBandRows + 1, 10, 8)},
+        // Rows whose passes along them run several blocks of four vector lanes and a remainder.
+        {"material hanging, wide", xpbd_scene(material, 7, 43, 8)},
         // The bundled scene that runs XPBD, on the grid of the simulation loops (support.hpp).
         {"stiff-drape", test::scene_for_loops("stiff-drape")},
     };

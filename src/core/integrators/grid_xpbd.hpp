@@ -12,9 +12,9 @@
 //  - skip-one springs along the rows in three passes per row (every third column), then down;
 //  - then the bends (spring.hpp): along the rows in three passes per row, then down, one batch per row.
 // So a correction travels down the cloth through a whole column in one pass, as in list order; along a
-// row it travels one spring per pass instead of the whole row. A row's springs along it are computed whole
-// and the other pass's corrections dropped (a masked vector loop, twice or three times the arithmetic of
-// that direction, cheaper than a strided one).
+// row it travels one spring per pass instead of the whole row. A pass along a row reads its elements' data
+// contiguously (slot()) and its particles two or three apart; the AVX2 kernel loads them as contiguous
+// vectors and transposes them in registers (grid_xpbd.cpp).
 // Interleaving the directions row by row instead (all of row r's springs, then row r + 1's) lets a
 // correction travel one row per pass: a cloth that hits a collider hard stretches far more (docs/
 // STIFF_CLOTH.md, "Rejected designs").
@@ -63,13 +63,20 @@ private:
 
     int rows_, cols_;
     bool bends_ = false;  // directions 4 and 5 hold bends, not skip-one springs
-    // Per direction d (fast_solver.cpp's six: (0,1) (1,0) (1,1) (1,-1) (0,2) (2,0)), per start particle i:
+    // The slot of direction d's element that starts at particle `start`, and back. Down the cloth (d = 1, 2, 3, 5)
+    // the slot is the start particle; along a row (d = 0 and 4, span 1 and 2 columns) a row's slots hold its
+    // elements by pass, each pass's (every (span + 1)th column) in column order, so a pass reads them contiguously.
+    std::size_t slot(int d, std::size_t start) const;
+    std::size_t start_of(int d, std::size_t slot) const;
+
+    // Per direction d (fast_solver.cpp's six: (0,1) (1,0) (1,1) (1,-1) (0,2) (2,0)), per slot (slot()):
     std::array<std::vector<int>, 6> source_;     // the element's index in topology.springs or .bends, -1 none
     std::array<std::vector<float>, 6> k_;        // k w (N/m), 0 for none
     std::array<std::vector<float>, 6> rest_;     // L0 (m) of a spring
     std::array<std::vector<double>, 6> alpha_;   // 1 / (k w h^2), infinite for none
     std::array<std::vector<double>, 6> lambda_;  // the last substep's multiplier of a spring
     std::array<DVec3Array, 2> bend_lambda_;      // ... of a bend along direction 4 + k (a vector constraint)
+    std::array<std::array<int, 3>, 2> first_slot_{};  // [span - 1][phase]: a pass's first slot in a row
     std::array<bool, 6> present_{};              // some element has k > 0 in direction d
     double alpha_h_ = 0.0;                       // the substep alpha_ is for (0: not set)
     double substep_ = 0.0;                       // the last substep's length, 0 before one
@@ -77,8 +84,6 @@ private:
     // Scratch kept across substeps.
     Vec3Array wind_;
     DVec3Array a_, start_;
-    std::vector<double> row_corrections_;  // 9 x cols: a row's corrections before they are added (grid_xpbd.cpp)
-    std::vector<int> phase2_, phase3_;     // each column modulo 2 and modulo 3: its pass along a row
     TeamChoice team_choice_;               // threads = 0: the team, or one thread while it is faster
     int last_threads_ = 1;
 };

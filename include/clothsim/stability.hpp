@@ -18,6 +18,7 @@
 
 #include "clothsim/mass_spring.hpp"
 
+#include <optional>
 #include <string>
 
 namespace clothsim {
@@ -80,6 +81,9 @@ StepCheck check_step(const MassSpring& sim, double energy_before, const GuardSet
 // integration.substeps and retries. Each change is described in `log` (one line each). Returns false when
 // the retries ran out (the simulation is then left at the last good state, never NaN).
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log);
+// The same, keeping the last good state in `last_good` between calls, whose storage each step reuses.
+bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log,
+                 std::optional<MassSpring>& last_good);
 
 // The largest |d| / L0 - 1 over springs with L0 > 0 (NaN-safe: a non-finite spring counts as infinite),
 // leaving out the springs of a grabbed particle and those between two pins (a strain the user imposes, by a

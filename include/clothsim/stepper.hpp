@@ -17,6 +17,7 @@
 #include "clothsim/stability.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace clothsim {
@@ -69,6 +70,7 @@ private:
     double accumulator_ = 0.0;       // s of simulated time owed
     StabilityLimit limit_;
     std::uint64_t limit_stamp_ = 0;  // the setup_stamp limit_ was computed for (0: none)
+    std::optional<MassSpring> last_good_;  // the guard's copy before each step, its storage kept between steps
 };
 
 }  // namespace clothsim

@@ -9,6 +9,7 @@
 #include <string>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace clothsim {
@@ -222,19 +223,34 @@ std::string what_bounds(const MassSpring& sim) {
 // One message a step that needed the guard: what blew up, what held (or that nothing did, and what the
 // stability bound asks for).
 bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log) {
+    std::optional<MassSpring> last_good;
+    return run_guarded(sim, steps, guard, log, last_good);
+}
+
+bool run_guarded(MassSpring& sim, long long steps, const GuardSettings& guard, std::string& log,
+                 std::optional<MassSpring>& last_good) {
+    double energy_after = std::numeric_limits<double>::quiet_NaN();  // the last step's, when it held
     for (long long done = 0; done < steps; ++done) {
         if (sim.asleep()) {  // asleep with nothing to wake it: the step moves nothing, there is nothing to check
             sim.run_steps(1);
+            energy_after = std::numeric_limits<double>::quiet_NaN();
             continue;
         }
-        const MassSpring good = sim;  // the last good state
-        const double energy_before = good.energy().total();
+        // The last good state, copied into the buffers of the one before (MassSpring's copy assignment keeps
+        // them): a fresh copy per step cost page faults.
+        if (last_good) *last_good = sim;
+        else last_good.emplace(sim);
+        const MassSpring& good = *last_good;
+        // Nothing changes the cloth between two steps of this loop: the energy after one is the next one's before.
+        const double energy_before = std::isnan(energy_after) ? good.energy().total() : energy_after;
         const int first = sim.settings().integration.substeps;
         BlowUp first_cause = BlowUp::None;
         for (int retries = 0;; ++retries) {
             sim.run_steps(1);
-            const BlowUp blow_up = check_step(sim, energy_before, guard).blow_up;
+            const StepCheck check = check_step(sim, energy_before, guard);
+            const BlowUp blow_up = check.blow_up;
             if (blow_up == BlowUp::None) {
+                energy_after = check.energy;
                 if (retries > 0) {
                     char line[256];
                     std::snprintf(line, sizeof line,

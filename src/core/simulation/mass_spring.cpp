@@ -74,7 +74,7 @@ void MassSpring::Internals::invalidate_iterative() {
 MassSpring::InternalsPtr::InternalsPtr() : p_(std::make_unique<Internals>()) {}
 MassSpring::InternalsPtr::InternalsPtr(const InternalsPtr& other) : p_(std::make_unique<Internals>(*other.p_)) {}
 MassSpring::InternalsPtr& MassSpring::InternalsPtr::operator=(const InternalsPtr& other) {
-    if (this != &other) p_ = std::make_unique<Internals>(*other.p_);
+    if (this != &other) *p_ = *other.p_;  // member by member: the vectors keep their storage
     return *this;
 }
 MassSpring::InternalsPtr::InternalsPtr(InternalsPtr&&) noexcept = default;

@@ -68,7 +68,7 @@ StepReport Stepper::run(MassSpring& sim, long long steps) {
         return report;
     }
     if (policy_.guard) {
-        report.guard_gave_up = !run_guarded(sim, steps, policy_.guard_settings, report.guard_log);
+        report.guard_gave_up = !run_guarded(sim, steps, policy_.guard_settings, report.guard_log, last_good_);
         // The guard chose the substeps that held; when nothing held it chose none and the substeps are as before.
         if (!report.guard_log.empty() && !report.guard_gave_up && policy_.auto_substeps) {
             policy_.auto_substeps = false;

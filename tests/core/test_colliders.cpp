@@ -1,5 +1,6 @@
 // Colliders: no free particle ends a step inside the sphere, the box, the cylinder or below the ground; the
 // shortest way out (the cylinder's faces, side and rims); continuous collision; Coulomb friction.
+#include "every_kernel.hpp"
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
@@ -11,6 +12,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -78,6 +80,14 @@ Scene lone_particle(glm::vec3 start, glm::vec3 velocity, int substeps) {
     s.settings.integration.substeps = substeps;
     s.settings.solver.sleep_speed = 0.0f;
     return s;
+}
+
+// Whether two arrays hold the same bits (NaN included).
+bool same_bits(const DVec3Array& a, const DVec3Array& b) {
+    auto same = [](const auto& u, const auto& v) {
+        return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+    };
+    return same(a.x, b.x) && same(a.y, b.y) && same(a.z, b.z);
 }
 
 // drape-sphere with a cylinder where the sphere was, its top face where the sphere's top is (per spring, 38
@@ -623,4 +633,46 @@ TEST_CASE("colliders the tablecloth settles on the round table mesh: no particle
         on_top += local.y > 0.76 && glm::length(glm::dvec2(local.x, local.z)) < 0.45;
     }
     CHECK(on_top > 100);  // it lies on the table, not on the floor beside it
+}
+
+TEST_CASE("colliders the sphere's four-lane block test moves every particle as the particle-by-particle test, on "
+          "every kernel", "[colliders]") {
+    ColliderSettings colliders;
+    const glm::dvec3 centre(glm::vec3(0.1f, 0.5f, -0.2f));  // as the collider holds it: r = 0 is its centre
+    colliders.shapes = {Collider{SphereCollider{glm::vec3(centre), 0.35f}, 0.4f, true}};
+    colliders.thickness = 0.005f;
+    // Particles from the centre to outside the shell and its thickness, moving slowly (a push with friction)
+    // or fast (a path through the sphere: the swept test), a few exactly at the centre, one NaN, and one
+    // block holding a pinned particle.
+    const std::size_t n = 64 * kBlockParticles;
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), radius(0.0, 0.37), slow(-0.002, 0.002), fast(-0.4, 0.4);
+    State start;
+    start.position.resize(n);
+    start.motion.resize(n);
+    start.mass.assign(n, 1.0f);
+    start.inverse_mass.assign(n, 1.0f);
+    start.pinned.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        glm::dvec3 direction(unit(rng), unit(rng), unit(rng));
+        if (glm::length(direction) < 1e-3) direction = {0.0, 1.0, 0.0};
+        const double r = i % 53 == 0 ? 0.0 : i % 3 == 0 ? 0.35 + 0.005 * unit(rng) : radius(rng);
+        start.position.set(i, centre + r * glm::normalize(direction));
+        const bool swept = i % 7 == 0;
+        start.motion.set(i, swept ? glm::dvec3(fast(rng), fast(rng), fast(rng)) : glm::dvec3(slow(rng), slow(rng), slow(rng)));
+    }
+    start.position.x[100] = std::nan("");
+    start.pinned[5 * kBlockParticles + 3] = 1;
+    test::with_every_kernel([&] {
+        State blocked = start, one_by_one = start;
+        CollisionBlocks blocks;
+        blocks.start = block_starts(n, 0, 0);
+        collide_stage(blocked, colliders, false, blocks, nullptr, 1);
+        collide_all(one_by_one, colliders);
+        CHECK(same_bits(blocked.position, one_by_one.position));
+        CHECK(same_bits(blocked.motion, one_by_one.motion));
+        std::size_t pushed = 0;
+        for (std::size_t i = 0; i < n; ++i) pushed += blocked.position.y[i] != start.position.y[i] ? 1 : 0;
+        CHECK(pushed > n / 2);
+    });
 }

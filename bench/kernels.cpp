@@ -4,6 +4,7 @@
 // what the fast solver's threads cost per substep with no work at all: the parallel region it opens each
 // substep against the barriers one region per step would need instead (docs/PERFORMANCE.md).
 #include "collision/colliders.hpp"
+#include "clothsim/mesh_shapes.hpp"
 #include "clothsim/normals.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
@@ -132,6 +133,21 @@ void BM_BarriersPerSubstep(benchmark::State& state) {
 
 }  // namespace
 
+// A mesh collider's tree (normals, edges, hierarchy: TriangleMesh's constructor) for the first `triangles` of
+// an icosphere of 81,920 (issue 45: a 50,000-triangle mesh in under 50 ms).
+void BM_MeshTree(benchmark::State& state) {
+    static const TriangleMesh sphere = icosphere(0.35, 6);
+    const auto count = static_cast<std::size_t>(state.range(0));
+    for (auto _ : state) {
+        state.PauseTiming();
+        std::vector<glm::dvec3> vertices = sphere.vertices();
+        std::vector<TriangleMesh::Triangle> triangles(sphere.triangles().begin(), sphere.triangles().begin() + static_cast<long>(count));
+        state.ResumeTiming();
+        TriangleMesh tree(std::move(vertices), std::move(triangles));
+        benchmark::DoNotOptimize(tree);
+    }
+}
+
 BENCHMARK(BM_TextbookSpringForces)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_TextbookSubstep)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_FastSubstep)->Args({64, 1})->Args({128, 1})->Args({256, 1})->Args({128, 2})->Args({256, 2})->UseRealTime();
@@ -139,6 +155,7 @@ BENCHMARK(BM_IntegrateVerlet)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_CollideSphere)->Arg(64)->Arg(128)->Arg(256);
 BENCHMARK(BM_VertexNormals)->Args({128, 0})->Args({128, 1})->Args({256, 0})->Args({256, 1})->UseRealTime();
 
+BENCHMARK(BM_MeshTree)->Arg(5120)->Arg(20480)->Arg(50000)->Arg(81920)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RegionPerSubstep)->Arg(2)->UseRealTime();
 BENCHMARK(BM_BarriersPerSubstep)->Arg(2)->UseRealTime();
 

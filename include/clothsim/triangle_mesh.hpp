@@ -100,7 +100,8 @@ private:
         std::uint32_t first;  // leaf: its triangles are order_[first, first + count); inner: the right child
         std::uint32_t count;  // 0 for an inner node, whose left child follows it
     };
-    std::uint32_t build(std::uint32_t first, std::uint32_t count);
+    // The node of order_[first, first + count), split at the median of the triangles' centres.
+    std::uint32_t build(std::uint32_t first, std::uint32_t count, const std::vector<glm::dvec3>& centres);
     bool closest_of(glm::dvec3 p, std::uint32_t t, double& best2, bool found, Nearest& out) const;
 
     std::vector<glm::dvec3> vertices_;

@@ -8,7 +8,6 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 namespace clothsim {
 namespace {
@@ -123,17 +122,10 @@ TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangl
         }
     }
     // Normals: each face's; each vertex's weighted by the face's angle there; each edge's the sum of its faces'
-    // (Baerentzen & Aanaes 2005). An edge is keyed by its two vertices, lower first.
+    // (Baerentzen & Aanaes 2005).
     const std::size_t n = triangles_.size();
     face_normals_.resize(n);
     vertex_normals_.assign(vertices_.size(), glm::dvec3(0.0));
-    std::unordered_map<std::uint64_t, glm::dvec3> edge_sum;
-    std::unordered_map<std::uint64_t, int> edge_use;  // +1 per a -> b with a < b, +1000 per b -> a: 1001 if paired
-    edge_sum.reserve(3 * n / 2 + 1);
-    edge_use.reserve(3 * n / 2 + 1);
-    auto key = [](std::uint32_t a, std::uint32_t b) {
-        return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-    };
     for (std::size_t t = 0; t < n; ++t) {
         const Triangle& tri = triangles_[t];
         const glm::dvec3 a = vertices_[tri[0]], b = vertices_[tri[1]], c = vertices_[tri[2]];
@@ -147,60 +139,103 @@ TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangl
             const double l1 = glm::length(e1), l2 = glm::length(e2);
             const double angle = l1 > 0.0 && l2 > 0.0 ? std::acos(std::clamp(glm::dot(e1, e2) / (l1 * l2), -1.0, 1.0)) : 0.0;
             vertex_normals_[tri[k]] += angle * normal;
-            const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
-            edge_sum[key(from, to)] += normal;
-            edge_use[key(from, to)] += from < to ? 1 : 1000;
         }
     }
     for (glm::dvec3& v : vertex_normals_) {
         const double length = glm::length(v);
         v = length > 0.0 ? v / length : glm::dvec3(0.0);
     }
-    closed_ = std::all_of(edge_use.begin(), edge_use.end(), [](const auto& e) { return e.second == 1001; });
+    // The edges: each triangle side (t, k) from tri[k] to tri[k + 1], listed under its lower vertex and sorted
+    // there by its upper vertex, then by 3 t + k, so the sides of one edge are neighbours and their faces'
+    // normals are summed in triangle order. The mesh is closed when every edge has one side each way.
+    const std::size_t sides = 3 * n;
+    std::vector<std::uint32_t> first_side(vertices_.size() + 1, 0);
+    auto ends = [&](std::size_t side) {
+        const Triangle& tri = triangles_[side / 3];
+        const std::uint32_t from = tri[side % 3], to = tri[(side % 3 + 1) % 3];
+        return std::pair{std::min(from, to), std::max(from, to)};
+    };
+    for (std::size_t side = 0; side < sides; ++side) ++first_side[ends(side).first + 1];
+    for (std::size_t v = 0; v < vertices_.size(); ++v) first_side[v + 1] += first_side[v];
+    std::vector<std::uint32_t> by_vertex(sides);
+    {
+        std::vector<std::uint32_t> cursor(first_side.begin(), first_side.end() - 1);
+        for (std::size_t side = 0; side < sides; ++side) by_vertex[cursor[ends(side).first]++] = static_cast<std::uint32_t>(side);
+    }
     edge_normals_.resize(n);
-    for (std::size_t t = 0; t < n; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const glm::dvec3 s = edge_sum[key(triangles_[t][k], triangles_[t][(k + 1) % 3])];
-            const double length = glm::length(s);
-            edge_normals_[t][k] = length > 0.0 ? s / length : face_normals_[t];
+    closed_ = true;
+    for (std::size_t v = 0; v < vertices_.size(); ++v) {
+        const auto begin = by_vertex.begin() + first_side[v], end = by_vertex.begin() + first_side[v + 1];
+        std::sort(begin, end, [&](std::uint32_t x, std::uint32_t y) {
+            const std::uint32_t ux = ends(x).second, uy = ends(y).second;
+            return ux != uy ? ux < uy : x < y;
+        });
+        for (auto group = begin; group != end;) {
+            const std::uint32_t upper = ends(*group).second;
+            auto group_end = group;
+            glm::dvec3 sum(0.0);
+            int forward = 0, backward = 0;
+            for (; group_end != end && ends(*group_end).second == upper; ++group_end) {
+                sum += face_normals_[*group_end / 3];
+                const Triangle& tri = triangles_[*group_end / 3];
+                (tri[*group_end % 3] < tri[(*group_end % 3 + 1) % 3] ? forward : backward) += 1;
+            }
+            closed_ = closed_ && forward == 1 && backward == 1;
+            const double length = glm::length(sum);
+            for (auto side = group; side != group_end; ++side) {
+                edge_normals_[*side / 3][*side % 3] = length > 0.0 ? sum / length : face_normals_[*side / 3];
+            }
+            group = group_end;
         }
     }
     order_.resize(n);
     for (std::size_t t = 0; t < n; ++t) order_[t] = static_cast<std::uint32_t>(t);
+    std::vector<glm::dvec3> centres(n);
+    for (std::size_t t = 0; t < n; ++t) {
+        const Triangle& tri = triangles_[t];
+        centres[t] = (vertices_[tri[0]] + vertices_[tri[1]] + vertices_[tri[2]]) / 3.0;
+    }
     nodes_.reserve(2 * (n / kLeafTriangles + 1));
-    build(0, static_cast<std::uint32_t>(n));
+    build(0, static_cast<std::uint32_t>(n), centres);
 }
 
-std::uint32_t TriangleMesh::build(std::uint32_t first, std::uint32_t count) {
+std::uint32_t TriangleMesh::build(std::uint32_t first, std::uint32_t count, const std::vector<glm::dvec3>& centres) {
     const auto index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.push_back(Node{glm::dvec3(std::numeric_limits<double>::infinity()),
-                          glm::dvec3(-std::numeric_limits<double>::infinity()), first, count});
-    glm::dvec3 lo = nodes_[index].lo, hi = nodes_[index].hi;
-    glm::dvec3 centre_lo = lo, centre_hi = hi;
-    auto centre = [&](std::uint32_t t) {
-        const Triangle& tri = triangles_[t];
-        return (vertices_[tri[0]] + vertices_[tri[1]] + vertices_[tri[2]]) / 3.0;
-    };
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    nodes_.push_back(Node{glm::dvec3(kInf), glm::dvec3(-kInf), first, count});
+    glm::dvec3 centre_lo(kInf), centre_hi(-kInf);
     for (std::uint32_t i = first; i < first + count; ++i) {
-        for (std::uint32_t v : triangles_[order_[i]]) {
-            lo = glm::min(lo, vertices_[v]);
-            hi = glm::max(hi, vertices_[v]);
-        }
-        const glm::dvec3 c = centre(order_[i]);
-        centre_lo = glm::min(centre_lo, c);
-        centre_hi = glm::max(centre_hi, c);
+        centre_lo = glm::min(centre_lo, centres[order_[i]]);
+        centre_hi = glm::max(centre_hi, centres[order_[i]]);
     }
-    nodes_[index].lo = lo;
-    nodes_[index].hi = hi;
     const glm::dvec3 extent = centre_hi - centre_lo;
-    if (count <= kLeafTriangles || !(std::max({extent.x, extent.y, extent.z}) > 0.0)) return index;
+    if (count <= kLeafTriangles || !(std::max({extent.x, extent.y, extent.z}) > 0.0)) {
+        glm::dvec3 lo(kInf), hi(-kInf);
+        for (std::uint32_t i = first; i < first + count; ++i) {
+            for (std::uint32_t v : triangles_[order_[i]]) {
+                lo = glm::min(lo, vertices_[v]);
+                hi = glm::max(hi, vertices_[v]);
+            }
+        }
+        nodes_[index].lo = lo;
+        nodes_[index].hi = hi;
+        return index;
+    }
     const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
     const std::uint32_t half = count / 2;
-    std::nth_element(order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
-                     [&](std::uint32_t a, std::uint32_t b) { return centre(a)[axis] < centre(b)[axis]; });
+    // The split on a copy of the keys beside the indices: nth_element then reads them in order instead of
+    // gathering centres (the same comparisons, so the same split).
+    std::vector<std::pair<double, std::uint32_t>> keyed(count);
+    for (std::uint32_t i = 0; i < count; ++i) keyed[i] = {centres[order_[first + i]][axis], order_[first + i]};
+    std::nth_element(keyed.begin(), keyed.begin() + half, keyed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::uint32_t i = 0; i < count; ++i) order_[first + i] = keyed[i].second;
+    const std::uint32_t left = build(first, half, centres);
+    const std::uint32_t right = build(first + half, count - half, centres);
+    // The box of the triangles below: the children's together (min and max are exact).
+    nodes_[index].lo = glm::min(nodes_[left].lo, nodes_[right].lo);
+    nodes_[index].hi = glm::max(nodes_[left].hi, nodes_[right].hi);
     nodes_[index].count = 0;
-    build(first, half);
-    const std::uint32_t right = build(first + half, count - half);
     nodes_[index].first = right;
     return index;
 }

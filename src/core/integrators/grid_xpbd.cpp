@@ -92,11 +92,10 @@ struct Particles {
     return violation2;
 }
 
-
 // The elements along a row (directions 0 and 4) are stored by pass: a row's slots hold first the elements
 // starting in the columns that are 0 modulo Span + 1, in column order, then those that are 1 modulo Span + 1,
 // and so on (GridXpbd::slot). A pass then reads its rest lengths, compliances and multipliers contiguously,
-// and its particles (Span + 1) apart, in groups that the compiler loads and stores whole.
+// and its particles (Span + 1) apart (strided loops here; the AVX2 kernels below transpose them in registers).
 
 // The elements of a pass along a row of `cols`: those starting in the columns c = phase + (span + 1) k that end
 // in the row, c + span < cols.

@@ -25,6 +25,17 @@ inline State free_particles(std::initializer_list<glm::vec3> positions, float ma
     return st;
 }
 
+// n free particles of mass 1 at the origin, at rest.
+inline State free_state(std::size_t n) {
+    State st;
+    st.position.resize(n);
+    st.motion.resize(n);
+    st.mass.assign(n, 1.0f);
+    st.inverse_mass.assign(n, 1.0f);
+    st.pinned.assign(n, 0);
+    return st;
+}
+
 // A vertical chain of `particles` particles spaced `spacing` apart hanging down from the origin, with only
 // structural springs of stiffness k, no gravity, no damping, no colliders, nothing pinned.
 inline Scene chain(int particles, float spacing, float particle_mass, float k) {

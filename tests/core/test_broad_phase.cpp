@@ -36,17 +36,6 @@ Box reference_bounds(const DVec3Array& p, std::size_t begin, std::size_t end) {
     return b;
 }
 
-// n free particles of mass 1 at the origin, at rest.
-State free_state(std::size_t n) {
-    State st;
-    st.position.resize(n);
-    st.motion.resize(n);
-    st.mass.assign(n, 1.0f);
-    st.inverse_mass.assign(n, 1.0f);
-    st.pinned.assign(n, 0);
-    return st;
-}
-
 // The substep's motion of the probed particles: for friction to act on, and a path for the swept test.
 const glm::vec3 kMotion(0.001f, -0.002f, 0.0005f);
 
@@ -472,7 +461,7 @@ TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of
     ColliderSettings colliders;
     test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.3f}, 0.4f, true};  // out of reach
     std::mt19937 rng(8);
-    State st = free_state(100);
+    State st = test::free_state(100);
     for (std::size_t i = 0; i < 100; ++i) {
         st.position.set(i, random_vec(rng, 1.0f));
         st.motion.set(i, 0.01f * random_vec(rng, 1.0f));
@@ -688,7 +677,7 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
     std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
     for (std::size_t size : {std::size_t{1}, std::size_t{7}, kBlockParticles, std::size_t{64}}) {
         INFO("blocks of " << size);
-        State culled = free_state(600);
+        State culled = test::free_state(600);
         for (std::size_t i = 0; i < 600; ++i) {
             culled.position.set(i, {x(rng), y(rng), z(rng)});
             culled.motion.set(i, {m(rng), m(rng), m(rng)});
@@ -737,7 +726,7 @@ TEST_CASE("broad_phase collide_stage shared by threads moves every particle exac
     const std::size_t n = 4 * kParallelCollisionParticles + 333;  // the ground's threshold too
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> x(-0.5f, 1.0f), y(-0.05f, 0.8f), z(-0.5f, 0.5f), m(-0.01f, 0.01f);
-    State start = free_state(n);
+    State start = test::free_state(n);
     std::vector<float> xs(n);
     for (float& v : xs) v = x(rng);
     std::sort(xs.begin(), xs.end());

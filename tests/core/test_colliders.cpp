@@ -647,12 +647,7 @@ TEST_CASE("colliders the sphere's four-lane block test moves every particle as t
     const std::size_t n = 64 * kBlockParticles;
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> unit(-1.0, 1.0), radius(0.0, 0.37), slow(-0.002, 0.002), fast(-0.4, 0.4);
-    State start;
-    start.position.resize(n);
-    start.motion.resize(n);
-    start.mass.assign(n, 1.0f);
-    start.inverse_mass.assign(n, 1.0f);
-    start.pinned.assign(n, 0);
+    State start = test::free_state(n);
     for (std::size_t i = 0; i < n; ++i) {
         glm::dvec3 direction(unit(rng), unit(rng), unit(rng));
         if (glm::length(direction) < 1e-3) direction = {0.0, 1.0, 0.0};

@@ -11,7 +11,7 @@ namespace clothsim {
 
 FrameLog::FrameLog(const std::filesystem::path& file) : out_(file, std::ios::trunc) {
     out_ << "frame,frame_ms,simulation_ms,render_ms,substeps,time,max_move,max_speed,mean_strain,kinetic_energy,"
-            "centroid_x,centroid_y,centroid_z\n";
+            "centroid_x,centroid_y,centroid_z,broken_springs\n";
     out_.flush();
     if (!out_) throw std::runtime_error("cannot write " + file.string());
 }
@@ -41,10 +41,10 @@ bool FrameLog::write(const FrameCost& cost, const MassSpring& sim) {
 
     ++frame_;
     char row[320];
-    std::snprintf(row, sizeof row, "%lld,%.4f,%.4f,%.4f,%lld,%.6f,%.6g,%.6g,%.6g,%.6g,%.6f,%.6f,%.6f\n", frame_,
+    std::snprintf(row, sizeof row, "%lld,%.4f,%.4f,%.4f,%lld,%.6f,%.6g,%.6g,%.6g,%.6g,%.6f,%.6f,%.6f,%zu\n", frame_,
                   cost.frame_ms, cost.sim_ms, cost.render_ms, cost.substeps, sim.time(), max_move, max_speed,
                   structural ? strain / double(structural) : 0.0, sim.energy().kinetic, centroid.x, centroid.y,
-                  centroid.z);
+                  centroid.z, sim.broken_springs());
     out_ << row;
     out_.flush();
     std::swap(previous_, current_);

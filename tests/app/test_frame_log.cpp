@@ -27,7 +27,7 @@ std::vector<std::vector<double>> rows_of(const std::filesystem::path& file) {
     std::string line;
     std::getline(in, line);
     CHECK(line == "frame,frame_ms,simulation_ms,render_ms,substeps,time,max_move,max_speed,mean_strain,kinetic_energy,"
-                  "centroid_x,centroid_y,centroid_z");
+                  "centroid_x,centroid_y,centroid_z,broken_springs");
     std::vector<std::vector<double>> rows;
     while (std::getline(in, line)) {
         std::vector<double> v;
@@ -54,7 +54,7 @@ TEST_CASE("frame log: each row is written as the frame ends, with how far the cl
 
     const std::vector<std::vector<double>> rows = rows_of(dir / "frames.csv");
     REQUIRE(rows.size() == 2);
-    REQUIRE(rows[1].size() == 13);
+    REQUIRE(rows[1].size() == 14);
     CHECK(rows[0][0] == 1);
     CHECK(rows[0][1] == 16.5);
     CHECK(rows[0][6] == 0.0);  // nothing to compare the first row with
@@ -80,6 +80,7 @@ TEST_CASE("frame log: each row is written as the frame ends, with how far the cl
     CHECK(rows[1][8] == Approx(strain / structural).epsilon(1e-4));
     CHECK(rows[1][9] == Approx(sim.energy().kinetic).epsilon(1e-5));
     CHECK(rows[1][11] == Approx(centroid.y).margin(1e-6));
+    CHECK(rows[1][13] == double(sim.broken_springs()));
 
     // A cloth rebuilt to another size: the move cannot be measured, and the row says so.
     scene.cloth.rows = 9;

@@ -113,6 +113,26 @@ TEST_CASE("mass_spring the same scene run twice gives bit-identical positions", 
     }
 }
 
+TEST_CASE("mass_spring a copy assigned over another simulation, or over a moved-from one, steps as the original",
+          "[mass_spring]") {
+    MassSpring original = build_simulation(load_scene("drape-sphere"));
+    original.run_steps(10);
+    MassSpring other = build_simulation(load_scene("flag"));  // another size: its storage is reused or regrown
+    other = original;
+    MassSpring moved = build_simulation(load_scene("hanging"));
+    MassSpring taker = std::move(moved);
+    moved = original;  // NOLINT(bugprone-use-after-move): assigning to a moved-from object is allowed
+    original.run_steps(20);
+    other.run_steps(20);
+    moved.run_steps(20);
+    for (const MassSpring* copy : {&other, &moved}) {
+        REQUIRE(copy->state().size() == original.state().size());
+        CHECK(copy->state().position == original.state().position);
+        CHECK(copy->state().motion == original.state().motion);
+    }
+    CHECK(taker.state().size() > 0);
+}
+
 TEST_CASE("mass_spring positions into a kept array equal positions(), whatever the array held", "[mass_spring]") {
     MassSpring sim = build_simulation(load_scene("drape-sphere"));
     sim.run_steps(30);

@@ -74,7 +74,9 @@ void MassSpring::Internals::invalidate_iterative() {
 MassSpring::InternalsPtr::InternalsPtr() : p_(std::make_unique<Internals>()) {}
 MassSpring::InternalsPtr::InternalsPtr(const InternalsPtr& other) : p_(std::make_unique<Internals>(*other.p_)) {}
 MassSpring::InternalsPtr& MassSpring::InternalsPtr::operator=(const InternalsPtr& other) {
-    if (this != &other) *p_ = *other.p_;  // member by member: the vectors keep their storage
+    if (this == &other) return *this;
+    if (p_) *p_ = *other.p_;  // member by member: the vectors keep their storage
+    else p_ = std::make_unique<Internals>(*other.p_);  // a moved-from simulation has none to keep
     return *this;
 }
 MassSpring::InternalsPtr::InternalsPtr(InternalsPtr&&) noexcept = default;

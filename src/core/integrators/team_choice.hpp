@@ -73,17 +73,26 @@ public:
             counted_ = 0;
         } else if (estimate < 0.0) {
             estimate = us;
+            recent_us_ = us;
         } else {
             // The mean substep of about the last kWindowUs of the choice in use (an exponential average, each
-            // substep weighted by its share of the window): what a frame pays. A shared machine's occasional
-            // preempted substep (a scheduler slice, milliseconds) moves it by that substep's share of the window
-            // only, so it does not make a faster team look slower; a team slowed on average (a core taken by
-            // another process) still overtakes one thread within about a window.
+            // substep weighted by its share of the window): what the choice costs over several frames. A shared
+            // machine's occasional preempted substep (a scheduler slice, milliseconds) moves it by that
+            // substep's share of the window only, so it does not make a faster team look slower (with a
+            // one-frame window, two slices close together made a 64 x 64 team look slower than one thread,
+            // which then ran until the next probe: a quarter to half of the substeps, 1.05-1.17x the team's
+            // time). A choice slowed on average (a core taken by another process) overtakes the other within
+            // about a window, and within a frame when it has become kJump times slower than the other's
+            // measure: the mean of the last kRecentUs says so, and becomes the choice's estimate.
             estimate += std::min(kMaxWeight, estimate / kWindowUs) * (us - estimate);
+            recent_us_ += std::min(kMaxWeight, recent_us_ / kRecentUs) * (us - recent_us_);
+            const double other = single ? team_us_ : single_us_;
+            if (other > 0.0 && recent_us_ > kJump * other) estimate = std::max(estimate, recent_us_);
         }
         if (single_us_ < 0.0 || team_us_ < 0.0) return;
         const bool was = single_;
         single_ = single_us_ < team_us_;
+        if (single_ != was) recent_us_ = single_ ? single_us_ : team_us_;
         // The wait before the next probe doubles when a probe loses, and when the choice a probe won turns out
         // slower over its window after all (a team preempted now and then wins short probes and loses on
         // average): either way the other choice was not worth trying so soon.
@@ -99,7 +108,9 @@ public:
     void reset() { *this = TeamChoice{}; }
 
 private:
-    static constexpr double kWindowUs = 16000.0;  // about a frame
+    static constexpr double kWindowUs = 128000.0;  // about eight frames
+    static constexpr double kRecentUs = 16000.0;   // about a frame
+    static constexpr double kJump = 1.5;           // a recent mean this many times the other's leaves at once
     static constexpr double kMaxWeight = 0.25;
     bool started_ = false;
     bool single_ = false;
@@ -108,6 +119,7 @@ private:
     int since_probe_ = 0;
     int wait_ = kFirstProbe;
     double single_us_ = -1.0, team_us_ = -1.0;
+    double recent_us_ = -1.0;  // the choice in use: its mean over the last kRecentUs
     double counted_us_ = 0.0;  // the probe under way: the time of its counted substeps
     int counted_ = 0;          // ... and their number
     double probe_us_ = 0.0;    // the time the probe under way has taken

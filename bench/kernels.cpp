@@ -81,7 +81,7 @@ void BM_CollideSphere(benchmark::State& state) {
     MassSpring sim = hanging(static_cast<int>(state.range(0)), SolverMethod::Textbook, 1);
     State st = sim.state();
     // A sphere through the middle of the cloth: about half the rows are near it.
-    const Collider sphere{SphereCollider{st.position.get(st.size() / 2), 0.3f}, 0.3f, true};
+    const Collider sphere{SphereCollider{st.position.get(st.size() / 2), 0.3f}, 0.3f, true, {}};
     for (auto _ : state) {
         collide(st, sphere, 0.005f);
         benchmark::DoNotOptimize(st.position.x.data());

@@ -149,7 +149,7 @@ int run_skipping(const SkippingOptions& o) {
                         std::erase_if(moved.colliders.shapes, [](const Collider& c) { return c.kind() == 0; });
                         if (far) {
                             moved.colliders.shapes.insert(moved.colliders.shapes.begin(),
-                                                          Collider{SphereCollider{{6.0f, 1.0f, 6.0f}, 0.3f}, 0.3f, true});
+                                                          Collider{SphereCollider{{6.0f, 1.0f, 6.0f}, 0.3f}, 0.3f, true, {}});
                         }
                         sim.apply(moved);
                     }

@@ -26,15 +26,28 @@ namespace clothsim {
 using ColliderShape = std::variant<SphereCollider, BoxCollider, CylinderCollider, PlaneCollider, MeshCollider>;
 inline constexpr std::size_t kColliderKindCount = std::variant_size_v<ColliderShape>;
 
-// One object: its shape, its friction and whether it collides now (the panel switches one off without losing it).
+// How a kinematic collider moves (collider_motion.hpp): its shape's fields are its pose at time 0, and it moves
+// at `velocity` and turns at `spin` from there, whatever the cloth does.
+inline constexpr double kMaxColliderSpeed = 100.0;  // m/s: the largest velocity component a scene gives
+inline constexpr double kMaxColliderSpin = 3600.0;  // degrees/s: ten turns a second
+struct ColliderMotion {
+    glm::vec3 velocity{0.0f};  // m/s
+    glm::vec3 spin{0.0f};      // degrees/s: the rates of the rotation angles about x, y and z (R = Rz Ry Rx)
+    bool moves() const { return velocity != glm::vec3(0.0f) || spin != glm::vec3(0.0f); }
+    bool operator==(const ColliderMotion&) const = default;
+};
+
+// One object: its shape, its friction, whether it collides now (the panel switches one off without losing it)
+// and how it moves.
 struct Collider {
     ColliderShape shape;
     float friction = 0.3f;  // Coulomb coefficient (0 = frictionless)
     bool enabled = true;
+    ColliderMotion motion;
     bool operator==(const Collider&) const = default;
     template <class Shape>
     static Collider of(Shape shape, bool enabled = true) {
-        return Collider{shape, Shape::kFriction, enabled};
+        return Collider{shape, Shape::kFriction, enabled, {}};
     }
     std::size_t kind() const { return shape.index(); }
 };

@@ -72,6 +72,9 @@ public:
     double substep_length() const;  // s: dt / substeps
 
     const SimulationSettings& settings() const { return settings_; }
+    // The colliders where they are now: the settings' list, with each moving one (collider_motion.hpp) posed at
+    // the simulation's time. What the renderer draws and the contact meets.
+    const std::vector<Collider>& colliders() const;
     // The one way to change the live settings: takes effect at the next substep. A change replans the stages
     // (step_plan.hpp), wakes the cloth (a moved collider, wind or a slider drives it) and moves
     // setup_stamp(); applying the settings already in force does nothing.
@@ -209,6 +212,9 @@ private:
     void add_external_forces(const State& state, Vec3Array& force, Vec3Array& scratch, StepProfile* profile,
                              bool holds = true) const;
     void replan();
+    void track_collider_motion();
+    void pose_colliders(double t0, double t1) const;
+    const ColliderSettings& colliders_now() const;
     // The stages of substep(), in pipeline order.
     void step_fast(double h, StepProfile* profile);
     void step_textbook(double h, StepProfile* profile);

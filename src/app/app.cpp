@@ -305,7 +305,7 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     if (io.MouseWheel != 0.0f) app.camera.zoom(io.MouseWheel);
     // A floor that collides is solid: the camera never goes under the lowest.
     float floor = INFINITY;
-    for (const Collider& c : app.sim.settings().colliders.shapes) {
+    for (const Collider& c : app.sim.colliders()) {
         if (const auto* plane = std::get_if<PlaneCollider>(&c.shape); plane && c.enabled) floor = std::min(floor, plane->height);
     }
     if (std::isfinite(floor)) app.camera.keep_above(floor);

@@ -237,7 +237,7 @@ void Renderer::draw_shadow_map(const RenderInput& input, const glm::mat4& light_
     shadow_.set("u_light_view_projection", light_view_projection);
     shadow_.set("u_model", glm::mat4(1.0f));
     if (!input.sim.topology().triangles.empty() || input.sim.surface().split()) cloth_->draw();
-    for (const Collider& collider : input.sim.settings().colliders.shapes) {
+    for (const Collider& collider : input.sim.colliders()) {
         const ShapeDrawing d = drawing(collider);
         if (!collider.enabled || d.mesh == UnitMesh::Plane) continue;  // the floor casts no shadow
         shadow_.set("u_model", model_of(d));
@@ -293,7 +293,7 @@ void Renderer::draw_lit(const RenderInput& input, const glm::mat4& view_projecti
 
     // The floor: each plane that collides, opaque; a faint grid at the first plane's height (or at 0) when none
     // does.
-    const std::vector<Collider>& shapes = input.sim.settings().colliders.shapes;
+    const std::vector<Collider>& shapes = input.sim.colliders();
     std::vector<float> floors;
     float faint = 0.0f;
     bool faint_set = false;

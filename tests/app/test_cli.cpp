@@ -336,7 +336,7 @@ TEST_CASE("cli: the text report of a headless run") {
 TEST_CASE("cli: an unknown scene exits 2 and lists the bundled scenes") {
     expect_bad_input({"--headless", "--scene", "no-such-scene"},
                      {"unknown scene", "no-such-scene", "curtain", "drape-cube", "drape-sphere", "falling", "flag",
-                      "hanging", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
+                      "hanging", "moving-ball", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
 }
 
 TEST_CASE("cli: a bad --set exits 2 and names the field") {
@@ -782,7 +782,7 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CHECK(r.code == 0);
     CHECK(lines_of(r.out) ==
           std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "fold",
-                                   "hanging", "pile", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
+                                   "hanging", "moving-ball", "pile", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

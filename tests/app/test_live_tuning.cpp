@@ -263,6 +263,9 @@ TEST_CASE("live tuning: fold takes wind, damping and stretch while it runs", "[e
 TEST_CASE("live tuning: hanging takes wind, damping and stretch while it runs", "[every-scene]") {
     tune_live("hanging", {});
 }
+TEST_CASE("live tuning: moving-ball takes wind, damping and stretch while the ball rolls", "[every-scene]") {
+    tune_live("moving-ball", {});
+}
 TEST_CASE("live tuning: pile takes damping and stretch while it runs (wind along a flat cloth exerts no force)",
           "[every-scene]") {
     tune_live("pile", {.wind_shows = false});

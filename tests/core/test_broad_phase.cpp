@@ -260,7 +260,7 @@ TEST_CASE("broad_phase block_bounds_for asks for lowest points when no collider 
     test::collider(c, "ground").enabled = true;
     CollisionBlocks blocks;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Lowest);  // the ground alone
-    test::collider(c, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.5f}, 0.3f, true};
+    test::collider(c, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.5f}, 0.3f, true, {}};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);  // no valid carried box
     blocks.carried_valid = true;
     blocks.carried_lo = glm::dvec3(-1.0, 0.0, -1.0), blocks.carried_hi = glm::dvec3(1.0, 2.0, 1.0);
@@ -268,10 +268,10 @@ TEST_CASE("broad_phase block_bounds_for asks for lowest points when no collider 
     blocks.carried_hi.y = 4.6;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);  // within its radius
     blocks.carried_hi.y = 2.0;
-    test::collider(c, "cube") = Collider{BoxCollider{{0.0f, 1.0f, 1.2f}, {0.5f, 0.5f, 0.5f}}, 0.3f, true};
+    test::collider(c, "cube") = Collider{BoxCollider{{0.0f, 1.0f, 1.2f}, {0.5f, 0.5f, 0.5f}}, 0.3f, true, {}};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);
     test::collider(c, "cube").enabled = false;
-    test::collider(c, "cylinder") = Collider{CylinderCollider{{3.0f, 1.0f, 0.0f}, 0.5f, 1.0f}, 0.3f, true};
+    test::collider(c, "cylinder") = Collider{CylinderCollider{{3.0f, 1.0f, 0.0f}, 0.5f, 1.0f}, 0.3f, true, {}};
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Lowest);
     test::cylinder(c).center.x = 1.4f;
     CHECK(block_bounds_for(c, blocks) == BlockBounds::Box);
@@ -299,7 +299,7 @@ TEST_CASE("broad_phase a cloth hanging onto the ground moves the same with or wi
             s.settings.solver.threads = threads;
             Scene with_sphere = s;
             test::collider(with_sphere.settings.colliders, "sphere") =
-                Collider{SphereCollider{{0.0f, 30.0f, 0.0f}, 1.0f}, 0.3f, true};
+                Collider{SphereCollider{{0.0f, 30.0f, 0.0f}, 1.0f}, 0.3f, true, {}};
             REQUIRE(block_bounds_for(s.settings.colliders, CollisionBlocks{}) == BlockBounds::Lowest);
             MassSpring lowest = build_simulation(s), whole = build_simulation(with_sphere);
             REQUIRE(lowest.plan().path == StepPath::FastVerlet);
@@ -329,7 +329,7 @@ Scene hanging_over_sphere(int threads, bool broad_phase, float tether_strain = 0
     apply_override(s, "cloth.rows=40");
     apply_override(s, "cloth.cols=40");
     s.settings.springs.tether_strain = tether_strain;
-    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.37f, -0.3f}, 0.2f}, 0.3f, true};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.37f, -0.3f}, 0.2f}, 0.3f, true, {}};
     s.settings.solver.threads = threads;
     s.settings.solver.broad_phase = broad_phase;
     return s;
@@ -441,7 +441,7 @@ TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has mo
         const glm::vec3 middle(sim.state().position.get(40 * 20 + 20));
         test::edit_settings(sim, [&](SimulationSettings& s) {
             test::collider(s.colliders, "sphere") =
-                Collider{SphereCollider{middle + glm::vec3(0.0f, 0.0f, 0.02f), 0.1f}, 0.3f, true};
+                Collider{SphereCollider{middle + glm::vec3(0.0f, 0.0f, 0.02f), 0.1f}, 0.3f, true, {}};
         });
         sim.substep();
         const SphereCollider& sphere = test::sphere(sim.settings().colliders);
@@ -459,7 +459,7 @@ TEST_CASE("broad_phase a sphere turned off, then on again where the cloth has mo
 TEST_CASE("broad_phase collide_stage takes the reach from the caller's bounds of the motion, from a pass when they "
           "are not finite", "[broad_phase]") {
     ColliderSettings colliders;
-    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.3f}, 0.4f, true};  // out of reach
+    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 5.0f, 0.0f}, 0.3f}, 0.4f, true, {}};  // out of reach
     std::mt19937 rng(8);
     State st = test::free_state(100);
     for (std::size_t i = 0; i < 100; ++i) {
@@ -535,7 +535,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the sphere would move"
         const SphereCollider sphere{random_vec(rng, pick_scale(rng)), radius(rng)};
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         const glm::vec3 p = sphere.center + random_direction(rng) * (sphere.radius + t + offset(rng));
-        check_conservative(Collider{sphere, 0.4f, true}, t, p, rng, tally);
+        check_conservative(Collider{sphere, 0.4f, true, {}}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
@@ -556,7 +556,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cube would move", 
             const int a = axis(rng);
             local[a] = (unit(rng) < 0.0f ? -1.0f : 1.0f) * (reach[a] + offset(rng));
         }
-        check_conservative(Collider{cube, 0.4f, true}, t, cube.center + local, rng, tally);
+        check_conservative(Collider{cube, 0.4f, true, {}}, t, cube.center + local, rng, tally);
     }
     check_coverage(tally);
 }
@@ -584,7 +584,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the cylinder would mov
             y = (y < 0.0f ? -1.0f : 1.0f) * (0.5f * cylinder.height + d * std::sin(b));
         }
         const glm::vec3 p = cylinder.center + glm::vec3(r * std::cos(a), y, r * std::sin(a));
-        check_conservative(Collider{cylinder, 0.4f, true}, t, p, rng, tally);
+        check_conservative(Collider{cylinder, 0.4f, true, {}}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
@@ -613,7 +613,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle a mesh would move", "[
         const PlacedMesh at = placed(mesh);
         const glm::dvec3 on = at.to_world(v[tri[0]] + a * (v[tri[1]] - v[tri[0]]) + b * (v[tri[2]] - v[tri[0]]));
         const glm::vec3 p = glm::vec3(on + at.rotation * ball->face_normals()[k] * double(t + offset(rng)));
-        check_conservative(Collider{mesh, 0.4f, true}, t, p, rng, tally);
+        check_conservative(Collider{mesh, 0.4f, true, {}}, t, p, rng, tally);
     }
     // The mesh's test is as loose as its leaf boxes (a few triangles each): it rejects far boxes, not near ones.
     INFO("rejected " << tally.rejected << ", accepted " << tally.accepted << ", moved " << tally.moved);
@@ -631,7 +631,7 @@ TEST_CASE("broad_phase may_touch never rejects a particle the ground would move"
         const float t = trial % 10 == 0 ? 0.0f : thickness(rng);
         glm::vec3 p = random_vec(rng, scale + 1.0f);
         p.y = ground.height + t + offset(rng);
-        check_conservative(Collider{ground, 0.5f, true}, t, p, rng, tally);
+        check_conservative(Collider{ground, 0.5f, true, {}}, t, p, rng, tally);
     }
     check_coverage(tally);
 }
@@ -650,11 +650,11 @@ MeshCollider ball_mesh() {
 TEST_CASE("broad_phase collide_stage with culling moves every particle exactly as testing them all", "[broad_phase]") {
     ColliderSettings colliders;
     colliders.shapes = {
-        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true},  // resting on the ground
-        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
-        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},  // on the ground too
-        Collider{PlaneCollider{0.0f}, 0.5f, true},
-        Collider{ball_mesh(), 0.3f, true},
+        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true, {}},  // resting on the ground
+        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true, {}},
+        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true, {}},  // on the ground too
+        Collider{PlaneCollider{0.0f}, 0.5f, true, {}},
+        Collider{ball_mesh(), 0.3f, true, {}},
     };
     colliders.thickness = 0.005f;
 
@@ -715,11 +715,11 @@ TEST_CASE("broad_phase collide_stage with culling moves every particle exactly a
 TEST_CASE("broad_phase collide_stage shared by threads moves every particle exactly as testing them all", "[broad_phase]") {
     ColliderSettings colliders;
     colliders.shapes = {
-        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true},
-        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true},
-        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true},
-        Collider{PlaneCollider{0.0f}, 0.5f, true},
-        Collider{ball_mesh(), 0.3f, true},
+        Collider{SphereCollider{{0.0f, 0.3f, 0.0f}, 0.3f}, 0.4f, true, {}},
+        Collider{BoxCollider{{0.5f, 0.2f, 0.1f}, {0.4f, 0.4f, 0.3f}}, 0.3f, true, {}},
+        Collider{CylinderCollider{{-0.3f, 0.25f, -0.3f}, 0.09f, 0.5f}, 0.3f, true, {}},
+        Collider{PlaneCollider{0.0f}, 0.5f, true, {}},
+        Collider{ball_mesh(), 0.3f, true, {}},
     };
     colliders.thickness = 0.005f;
     // Enough particles for the stage to share its blocks among threads, in the cloth's order (blocks along x).

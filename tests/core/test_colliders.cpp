@@ -25,7 +25,7 @@ namespace {
 // A collider of `shape`, switched on and frictionless.
 template <class Shape>
 Collider frictionless(const Shape& shape) {
-    return Collider{shape, 0.0f, true};
+    return Collider{shape, 0.0f, true, {}};
 }
 
 // Smallest signed distance of a free particle to each enabled collider (m).
@@ -54,7 +54,7 @@ Clearance clearance(const MassSpring& sim) {
 MassSpring slider(float friction, float speed) {
     Scene s = test::chain(1, 1.0f, 0.1f, 0.0f);
     s.settings.forces.gravity = {0.0f, -9.81f, 0.0f};
-    test::collider(s.settings.colliders, "ground") = Collider{PlaneCollider{0.0f}, friction, true};
+    test::collider(s.settings.colliders, "ground") = Collider{PlaneCollider{0.0f}, friction, true, {}};
     s.settings.colliders.thickness = 0.005f;
     s.cloth.origin = {0.0f, 0.005f, 0.0f};
     s.cloth.velocity = {speed, 0.0f, 0.0f};
@@ -66,7 +66,7 @@ MassSpring slider(float friction, float speed) {
 // The Cusick drape tester's support (ISO 9073-9, BS 5058: an 18 cm disc), here a solid cylinder 0.3 m tall
 // standing on y = 0.1; its top face is at y = 0.4.
 Collider support(float friction) {
-    return Collider{CylinderCollider{{0.1f, 0.25f, -0.2f}, 0.09f, 0.3f}, friction, true};
+    return Collider{CylinderCollider{{0.1f, 0.25f, -0.2f}, 0.09f, 0.3f}, friction, true, {}};
 }
 
 // One free particle at `start` moving at `velocity`, with gravity, no ground, `substeps` per 1/60 s step.
@@ -95,7 +95,7 @@ bool same_bits(const DVec3Array& a, const DVec3Array& b) {
 Scene drape_on_cylinder() {
     Scene s = per_spring_scene("drape-sphere");
     test::collider(s.settings.colliders, "sphere").enabled = false;
-    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true, {}};
     return s;
 }
 
@@ -428,7 +428,7 @@ TEST_CASE("colliders friction on the cylinder's top face slows sliding at mu g a
     // A wide disc (radius 0.5) so the particle stops on it: at most 0.255 m from x = -0.4 at 1 m/s.
     const float v0 = 1.0f;
     auto sliding = [&](float mu) {
-        const Collider cylinder{CylinderCollider{{0.0f, 0.1f, 0.0f}, 0.5f, 0.2f}, mu, true};
+        const Collider cylinder{CylinderCollider{{0.0f, 0.1f, 0.0f}, 0.5f, 0.2f}, mu, true, {}};
         Scene s = lone_particle({-0.4f, 0.2f + 0.005f, 0.0f}, {v0, 0.0f, 0.0f}, 20);
         test::collider(s.settings.colliders, "cylinder") = cylinder;
         return build_simulation(s);
@@ -639,7 +639,7 @@ TEST_CASE("colliders the sphere's four-lane block test moves every particle as t
           "every kernel", "[colliders]") {
     ColliderSettings colliders;
     const glm::dvec3 centre(glm::vec3(0.1f, 0.5f, -0.2f));  // as the collider holds it: r = 0 is its centre
-    colliders.shapes = {Collider{SphereCollider{glm::vec3(centre), 0.35f}, 0.4f, true}};
+    colliders.shapes = {Collider{SphereCollider{glm::vec3(centre), 0.35f}, 0.4f, true, {}}};
     colliders.thickness = 0.005f;
     // Particles from the centre to outside the shell and its thickness, moving slowly (a push with friction)
     // or fast (a path through the sphere: the swept test), a few exactly at the centre, one NaN, and one

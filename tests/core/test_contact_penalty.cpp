@@ -51,7 +51,7 @@ Scene particle_over_cylinder(double x, double y, int substeps) {
     Scene s = particle_over_ground(y, 0.0f, Integrator::Rk4, SolverMethod::Textbook, substeps);
     s.cloth.origin.x = static_cast<float>(x);
     test::collider(s.settings.colliders, "ground").enabled = false;
-    test::collider(s.settings.colliders, "cylinder") = Collider{kSupport, 0.0f, true};
+    test::collider(s.settings.colliders, "cylinder") = Collider{kSupport, 0.0f, true, {}};
     return s;
 }
 
@@ -95,7 +95,7 @@ TEST_CASE("penalty contact force and potential follow k p^3 / t^2 and k p^4 / (4
 
     // The sphere pushes along its normal, the same depth as the projection's (radius + t - distance).
     test::collider(colliders, "ground").enabled = false;
-    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.0f, 0.0f}, 0.5f}, 0.0f, true};
+    test::collider(colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.0f, 0.0f}, 0.5f}, 0.0f, true, {}};
     state.pinned[0] = 0;
     const glm::dvec3 dir = glm::normalize(glm::dvec3(1.0, 2.0, -2.0));
     state.position.set(0, dir * (0.5 + t - p));
@@ -109,7 +109,7 @@ TEST_CASE("penalty contact force and potential follow k p^3 / t^2 and k p^4 / (4
     // its nearest point: up from the top face, out from the side, and from a rim along the diagonal.
     test::collider(colliders, "sphere").enabled = false;
     // top face y = 0.5, side r = 0.5
-    test::collider(colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.0f, 0.0f}, 0.5f, 1.0f}, 0.0f, true};
+    test::collider(colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.0f, 0.0f}, 0.5f, 1.0f}, 0.0f, true, {}};
     const double top = 0.5 * double(test::cylinder(colliders).height), side = double(test::cylinder(colliders).radius);
     const glm::dvec3 around = glm::normalize(glm::dvec3(1.0, 0.0, -2.0));  // a direction around the axis
     const glm::dvec3 rim_dir = glm::normalize(glm::dvec3(3.0, 4.0, 0.0));
@@ -271,7 +271,7 @@ TEST_CASE("penalty contact: fast and textbook solvers give bit-identical drapes"
 
     // The same with a cylinder in the sphere's place, its top face where the sphere's top is.
     test::collider(scene.settings.colliders, "sphere").enabled = false;
-    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.0f, true};
+    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.0f, true, {}};
     const MassSpring fast_cylinder = run(SolverMethod::Fast);
     const MassSpring textbook_cylinder = run(SolverMethod::Textbook);
     CHECK(fast_cylinder.energy().contact_potential > 0.0);  // the cloth is on the cylinder

@@ -129,7 +129,7 @@ TEST_CASE("fast solver agrees with the textbook solver bit for bit on a cloth dr
     // Per spring: at its 38 substeps a step 1000 substeps are 0.44 s, enough to fall that far.
     Scene scene = per_spring_scene("drape-sphere");
     test::collider(scene.settings.colliders, "sphere").enabled = false;
-    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
+    test::collider(scene.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true, {}};
     const MassSpring textbook = run(scene, SolverMethod::Textbook, 1, 1000);
     const CylinderCollider& c = test::cylinder(scene.settings.colliders);
     for (int threads : {1, 2, 3}) {

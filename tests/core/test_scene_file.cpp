@@ -87,16 +87,16 @@ std::string shortest(double v) {
 // Bundled scenes
 // ---------------------------------------------------------------------------------------------------------
 
-TEST_CASE("scene: the bundled scene list is exactly the thirteen shipped scenes") {
-    const std::vector<std::string> expected = {"curtain", "cusick",        "drape-cube", "drape-sphere", "falling",
-                                               "flag",    "fold",          "hanging",    "pile",         "stiff-drape",
-                                               "stiff-hanging", "tablecloth", "tear"};
+TEST_CASE("scene: the bundled scene list is exactly the fourteen shipped scenes") {
+    const std::vector<std::string> expected = {"curtain", "cusick",      "drape-cube", "drape-sphere", "falling",
+                                               "flag",    "fold",        "hanging",    "moving-ball",  "pile",
+                                               "stiff-drape", "stiff-hanging", "tablecloth", "tear"};
     REQUIRE(clothsim::bundled_scene_names() == expected);
 }
 
 TEST_CASE("scene: every bundled scene loads, builds and stays finite for 2 simulated seconds (0.5 s sanitized)") {
     const std::vector<std::string> names = clothsim::bundled_scene_names();
-    REQUIRE(names.size() == 13);
+    REQUIRE(names.size() == 14);
     for (const std::string& name : names) {
         INFO("scene " << name);
         // The costly scenes run the 2 s on a coarser grid (tests/support.hpp), and one step at their own size.
@@ -958,7 +958,7 @@ TEST_CASE("scene file: the cylinder collider loads, overrides, round-trips and r
     apply_override(o, "colliders.cylinder.height=0.6");
     apply_override(o, "colliders.cylinder.friction=0");
     CHECK(test::collider(std::as_const(o.settings.colliders), "cylinder") ==
-          Collider{CylinderCollider{{0.0f, 0.3f, 0.0f}, 0.09f, 0.6f}, 0.0f, true});
+          Collider{CylinderCollider{{0.0f, 0.3f, 0.0f}, 0.09f, 0.6f}, 0.0f, true, {}});
 
     const std::string height = parse_error("[colliders.cylinder]\nheight = -0.1\n");
     CHECK_THAT(height, Contains("test.toml:2:") && Contains("colliders.cylinder.height") &&
@@ -1030,4 +1030,34 @@ TEST_CASE("scene copy_field: every field of every kind takes the other scene's v
     kinds_copied.erase(std::unique(kinds_copied.begin(), kinds_copied.end()), kinds_copied.end());
     CHECK(copies > 50);
     CHECK(kinds_copied.size() >= 7);  // int, float, bool, vec2, vec3, string, pins and enumerations among them
+}
+
+TEST_CASE("scene file: a collider's velocity and spin load, override, round-trip; a spin its shape cannot follow is refused") {
+    using namespace clothsim;
+    const Scene s = parse_scene("[[colliders.shapes]]\nkind = \"sphere\"\ncenter = [0, 0.3, -1]\nradius = 0.3\n"
+                                "velocity = [0, 0, 0.5]\nspin = [-95.5, 0, 0]\n",
+                                "test.toml");
+    const Collider& ball = s.settings.colliders.shapes.at(0);
+    CHECK(ball.motion.velocity == glm::vec3(0.0f, 0.0f, 0.5f));
+    CHECK(ball.motion.spin == glm::vec3(-95.5f, 0.0f, 0.0f));
+    const std::string text = to_toml(s);
+    CHECK_THAT(text, Contains("velocity = [0.0, 0.0, 0.5]") && Contains("spin = [-95.5, 0.0, 0.0]"));
+    CHECK(parse_scene(text, "saved.toml").settings == s.settings);
+    // A still collider's entry carries no motion rows.
+    const std::string still = to_toml(Scene{});
+    CHECK_THAT(still.substr(still.find("[[colliders.shapes]]")), !Contains("velocity") && !Contains("spin"));
+
+    Scene o;
+    apply_override(o, "colliders.shapes.0.velocity=[1, 0, 0]");
+    CHECK(o.settings.colliders.shapes.at(0).motion.velocity == glm::vec3(1.0f, 0.0f, 0.0f));
+
+    CHECK_THAT(parse_error("[[colliders.shapes]]\nkind = \"sphere\"\nvelocity = [0, 0, 1000]\n"),
+               Contains("test.toml:3:") && Contains("velocity") && Contains("[-100.0, 100.0] m/s"));
+    CHECK_THAT(parse_error("[[colliders.shapes]]\nkind = \"box\"\nspin = [0, 30, 0]\n"),
+               Contains("colliders.shapes[0] (box): spin = [0.0, 30.0, 0.0]") && Contains("axis-aligned"));
+    CHECK_THAT(parse_error("[[colliders.shapes]]\nkind = \"cylinder\"\nspin = [10, 0, 0]\n"),
+               Contains("cylinder stays vertical") && Contains("[0, w, 0]"));
+    Scene unchanged = o;
+    CHECK_THAT(override_error(unchanged, "colliders.shapes.0.spin=[5, 0, 0]"), Contains("horizontal"));
+    CHECK(unchanged.settings == o.settings);
 }

@@ -334,7 +334,7 @@ TEST_CASE("sleep moving a collider wakes a sleeping cloth", "[sleep]") {
     }
     SECTION("a sphere moved into the cloth") {
         Scene scene = settling_scene();
-        test::collider(scene.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.5f, 3.0f}, 0.2f}, 0.3f, true};  // out of the way
+        test::collider(scene.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 0.5f, 3.0f}, 0.2f}, 0.3f, true, {}};  // out of the way
         MassSpring sim = build_simulation(scene);
         settle(sim);
         const std::vector<glm::vec3> held = sim.positions();

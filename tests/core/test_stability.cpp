@@ -793,7 +793,7 @@ TEST_CASE("stability a sphere around pinned particles: pinned stay put, free one
           "[stability]") {
     Scene s;
     s.cloth.rows = s.cloth.cols = 12;  // top corners (row 0) pinned at (-0.5, 1.5, 0) and (0.5, 1.5, 0)
-    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{-0.5f, 1.5f, 0.0f}, 0.25f}, 0.3f, true};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{-0.5f, 1.5f, 0.0f}, 0.25f}, 0.3f, true, {}};
     MassSpring sim = build_simulation(s);
     const glm::vec3 pin0 = sim.position(0), pin1 = sim.position(11);
     REQUIRE(signed_distance(test::sphere(s.settings.colliders), pin0) < 0.0f);
@@ -818,7 +818,7 @@ TEST_CASE("stability a sphere enclosing the whole cloth pushes every particle to
     s.pins.preset = PinPreset::None;
     s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
     test::collider(s.settings.colliders, "ground").enabled = false;
-    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 10.0f}, 0.3f, true};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 10.0f}, 0.3f, true, {}};
     MassSpring sim = build_simulation(s);
     REQUIRE(sim.position(12) == glm::vec3(0.0f, 1.0f, 0.0f));
     const float surface = 10.0f + s.settings.colliders.thickness;

@@ -52,7 +52,7 @@ Scene drape_scene(const std::string& name) {
     if (name != "drape-cylinder") return per_spring_scene(name);
     Scene s = per_spring_scene("drape-sphere");
     test::collider(s.settings.colliders, "sphere").enabled = false;
-    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true};
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.0f, 0.425f, 0.0f}, 0.3f, 0.85f}, 0.4f, true, {}};
     return s;
 }
 
@@ -196,9 +196,9 @@ TEST_CASE("step_plan a collider out of reach changes nothing and the broad phase
         INFO(method_name(method) << " solver");
         Scene without = small_hanging(method);
         Scene far = without;
-        test::collider(far.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, -50.0f, 0.0f}, 1.0f}, 0.3f, true};
+        test::collider(far.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, -50.0f, 0.0f}, 1.0f}, 0.3f, true, {}};
         test::collider(far.settings.colliders, "cylinder") =
-            Collider{CylinderCollider{{30.0f, 1.0f, 0.0f}, 1.0f, 2.0f}, 0.3f, true};
+            Collider{CylinderCollider{{30.0f, 1.0f, 0.0f}, 1.0f, 2.0f}, 0.3f, true, {}};
         MassSpring a = build_simulation(without);
         MassSpring b = build_simulation(far);
         CHECK_FALSE(a.plan().solids);
@@ -540,8 +540,8 @@ void check_describe_matches_profile(const MassSpring& sim) {
 Scene busy(SolverMethod method) {
     Scene s = small_hanging(method);
     s.settings.forces.wind = {0.0f, 0.0f, 2.0f};
-    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 0.3f}, 0.3f, true};
-    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.3f, 0.6f, 0.0f}, 0.1f, 0.3f}, 0.3f, true};
+    test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.0f, 0.0f}, 0.3f}, 0.3f, true, {}};
+    test::collider(s.settings.colliders, "cylinder") = Collider{CylinderCollider{{0.3f, 0.6f, 0.0f}, 0.1f, 0.3f}, 0.3f, true, {}};
     s.settings.springs.strain_limit = 0.1f;
     s.settings.forces.max_speed = 20.0f;
     return s;

@@ -155,6 +155,12 @@ constexpr RecordedFile kRecordedFiles[] = {
     {"tablecloth", "solver.threads=2", 40, 0x01eab201b57bd5b6ull},
     {"tablecloth", "solver.method=textbook", 40, 0x01eab201b57bd5b6ull},
     {"tablecloth", "solver.broad_phase=false", 40, 0x01eab201b57bd5b6ull},
+    // A kinematic collider (a rolling ball, recorded when colliders came to move): the same contacts on every
+    // path and thread count, the broad phase reaching the relative paths' starts.
+    {"moving-ball", "", 40, 0x22dc13ea4b81e0a0ull},
+    {"moving-ball", "solver.threads=2", 40, 0x22dc13ea4b81e0a0ull},
+    {"moving-ball", "solver.method=textbook", 40, 0x22dc13ea4b81e0a0ull},
+    {"moving-ball", "solver.broad_phase=false", 40, 0x22dc13ea4b81e0a0ull},
 };
 
 }  // namespace

@@ -155,7 +155,7 @@ TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep
             for (int threads : test::thread_counts({1, 2, 3})) {
                 Scene s = hanging(40, 0.001f);
                 test::plane(s.settings.colliders).height = -10.0f;
-                test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 20.0f, 0.0f}, 1.0f}, 0.3f, sphere};
+                test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 20.0f, 0.0f}, 1.0f}, 0.3f, sphere, {}};
                 s.settings.solver.threads = threads;
                 MassSpring fast = build_simulation(s);
                 REQUIRE(fast.plan().path == StepPath::FastVerlet);

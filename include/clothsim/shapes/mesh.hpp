@@ -48,8 +48,8 @@ struct MeshCollider {
 };
 
 // R = Rz Ry Rx for `degrees` about x, y and z.
-inline glm::dmat3 rotation_matrix(glm::vec3 degrees) {
-    const glm::dvec3 r = glm::dvec3(degrees) * (std::numbers::pi / 180.0);
+inline glm::dmat3 rotation_matrix(glm::dvec3 degrees) {
+    const glm::dvec3 r = degrees * (std::numbers::pi / 180.0);
     const double cx = std::cos(r.x), sx = std::sin(r.x), cy = std::cos(r.y), sy = std::sin(r.y);
     const double cz = std::cos(r.z), sz = std::sin(r.z);
     const glm::dmat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);  // column-major

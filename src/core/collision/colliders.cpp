@@ -22,15 +22,20 @@ namespace {
 // Returns a bound on how far it moved any particle: each push is at most depth (1 + friction) long (the normal
 // push plus a friction cut of at most friction x depth), or the way back to where a swept path entered. A NaN
 // position has NaN depth and is left alone (the guard reports it).
+//
+// A moving collider (`surface` not null, collider_motion.hpp) works on the motion relative to its surface: the
+// particle's motion less the surface's displacement where it ends, and gives the surface's displacement back
+// with what is left of it.
 template <class T, class Shape>
 T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::size_t begin,
-                std::size_t end) {
+                std::size_t end, const SurfaceMotion* surface = nullptr) {
     using Vec = glm::vec<3, T>;
     T deepest = T(0);
     for (std::size_t i = begin; i < end; ++i) {
         if (state.pinned[i]) continue;
         const Contact<T> c = contact(shape, state.position.get(i), thickness);
-        const Vec motion = state.motion.get(i);
+        const Vec carried = surface ? Vec(surface->displacement(state.position.get(i))) : Vec(T(0));
+        const Vec motion = surface ? state.motion.get(i) - carried : state.motion.get(i);
         // A large step can end outside after passing through (no contact at the end), or inside past the
         // middle, where the nearest way out points along the motion and leads out of the far side. Then the
         // particle stops where its path (x - motion -> x: the motion is the substep's displacement for every
@@ -52,7 +57,8 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
                 const Vec entry = p0 + hit->t * motion;
                 deepest = std::max(deepest, glm::length(p1 - entry));
                 state.position.set(i, entry);
-                state.motion.set(i, motion - std::min(glm::dot(motion, hit->normal), T(0)) * hit->normal);
+                const Vec kept = motion - std::min(glm::dot(motion, hit->normal), T(0)) * hit->normal;
+                state.motion.set(i, surface ? kept + Vec(surface->displacement(entry)) : kept);
                 continue;
             }
         }
@@ -67,7 +73,8 @@ T collide_shape(State& state, const Shape& shape, T friction, T thickness, std::
         // Inelastic contact: the push moves the particle out but does not launch it. Keeping the push in
         // the motion (x_prev left in place, as plain Verlet projection does) turns a deep penetration into a
         // velocity of depth / h: a cloth started half inside the sphere exploded that way.
-        state.motion.set(i, tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal);
+        const Vec kept = tangential + friction_cut + std::max(normal_motion, T(0)) * c.normal;
+        state.motion.set(i, surface ? kept + carried : kept);
     }
     return std::max(deepest * (T(1) + friction), deepest);
 }
@@ -161,15 +168,19 @@ __attribute__((target("avx2,fma"))) double collide_sphere_block_avx2(State& stat
 // Returns the number of blocks tested: none, and no particle moved.
 template <class Shape>
 long long collide_blocks(State& state, const Shape& shape, float friction, float thickness, bool broad_phase,
-                         CollisionBlocks& blocks, const Box& cloth, std::size_t kind, int threads, StepProfile* profile) {
+                         CollisionBlocks& blocks, const Box& cloth, std::size_t kind, int threads, StepProfile* profile,
+                         const SurfaceMotion* surface) {
     // First the whole cloth (`cloth` holds it): a collider out of its reach costs this one test; then each
-    // block's box. `at`: the shape as its queries take it (shape.hpp: placed).
+    // block's box. `at`: the shape as its queries take it (shape.hpp: placed). A moving collider's relative
+    // paths start up to its surface's largest displacement outside the swept boxes: the test reaches that much
+    // farther.
     decltype(auto) at = placed(shape, thickness);
-    const bool whole_cloth = !broad_phase || may_touch(at, thickness, cloth);
+    const float reach = surface ? static_cast<float>(thickness + surface->reach) : thickness;
+    const bool whole_cloth = !broad_phase || may_touch(at, reach, cloth);
     blocks.tested.clear();
     std::size_t particles = 0;
     for (std::size_t k = 0; whole_cloth && k < blocks.count(); ++k) {
-        if (broad_phase && !may_touch(at, thickness, blocks.boxes[k])) continue;
+        if (broad_phase && !may_touch(at, reach, blocks.boxes[k])) continue;
         blocks.tested.push_back(static_cast<std::uint32_t>(k));
         particles += blocks.start[k + 1] - blocks.start[k];
     }
@@ -184,14 +195,14 @@ long long collide_blocks(State& state, const Shape& shape, float friction, float
         const std::size_t begin = blocks.start[k], end = blocks.start[k + 1];
         double bound = 0.0;
         if constexpr (std::is_same_v<Shape, SphereCollider>) {
-            if (FastSolver::kernel() != FastKernel::Generic && end - begin == kBlockParticles &&
+            if (!surface && FastSolver::kernel() != FastKernel::Generic && end - begin == kBlockParticles &&
                 std::none_of(state.pinned.begin() + begin, state.pinned.begin() + end, [](std::uint8_t p) { return p != 0; })) {
                 bound = collide_sphere_block_avx2(state, at, double(friction), double(thickness), begin);
             } else {
-                bound = collide_shape(state, at, double(friction), double(thickness), begin, end);
+                bound = collide_shape(state, at, double(friction), double(thickness), begin, end, surface);
             }
         } else {
-            bound = collide_shape(state, at, double(friction), double(thickness), begin, end);
+            bound = collide_shape(state, at, double(friction), double(thickness), begin, end, surface);
         }
         const float moved = static_cast<float>(bound);
         if (moved > 0.0f && broad_phase) {
@@ -252,6 +263,11 @@ bool any_solid(const ColliderSettings& colliders) {
                        [](const Collider& c) { return c.enabled && !is_half_space(c); });
 }
 
+bool any_moving_solid(const ColliderSettings& colliders) {
+    return std::any_of(colliders.shapes.begin(), colliders.shapes.end(),
+                       [](const Collider& c) { return c.enabled && !is_half_space(c) && c.motion.moves(); });
+}
+
 bool any_half_space(const ColliderSettings& colliders) {
     return std::any_of(colliders.shapes.begin(), colliders.shapes.end(),
                        [](const Collider& c) { return c.enabled && is_half_space(c); });
@@ -261,12 +277,14 @@ bool any_half_space(const ColliderSettings& colliders) {
 
 BlockBounds block_bounds_for(const ColliderSettings& colliders, const CollisionBlocks& blocks) {
     if (!any_solid(colliders)) return BlockBounds::Lowest;
+    // The carried box is tested against where the solids are now; a moving one is somewhere else next substep.
+    if (any_moving_solid(colliders)) return BlockBounds::Box;
     return blocks.carried_valid && !solids_may_touch(colliders, blocks.carried()) ? BlockBounds::Lowest
                                                                                    : BlockBounds::Box;
 }
 
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile, int threads, const MotionBounds* motion) {
+                   StepProfile* profile, int threads, const MotionBounds* motion, const SurfaceMotion* surfaces) {
     if (blocks.start.empty() || blocks.start.back() != state.size()) {
         blocks.start = block_starts(state.size(), 0, 0);
         blocks.current = blocks.boxes_current = false;
@@ -283,6 +301,8 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     } else if (!(blocks.current && blocks.boxes.size() == count)) {
         StageTimer timer(profile, Stage::BroadPhase);
         bool from_sweep = blocks.boxes_current && blocks.boxes.size() == count;
+        if (!from_sweep) blocks.bounds = BlockBounds::Box;
+        if (blocks.bounds == BlockBounds::Lowest && shapes && any_moving_solid(colliders)) from_sweep = false;
         if (!from_sweep) blocks.bounds = BlockBounds::Box;
         if (blocks.bounds == BlockBounds::Lowest && shapes) {
             // Lowest points only: the sphere, the cube and the cylinder test the carried box, grown by this
@@ -330,13 +350,15 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
     const Box shape_cloth = blocks.bounds == BlockBounds::Lowest ? blocks.carried() : blocks.cloth;
     {
         StageTimer timer(profile, Stage::Colliders);
-        for (const Collider& c : colliders.shapes) {
+        for (std::size_t i = 0; i < colliders.shapes.size(); ++i) {
+            const Collider& c = colliders.shapes[i];
             if (!c.enabled) continue;
             // A half-space reads the blocks' lowest points, which every box holds.
             const Box& cloth = is_half_space(c) ? blocks.cloth : shape_cloth;
+            const SurfaceMotion* surface = surfaces && c.motion.moves() ? &surfaces[i] : nullptr;
             tested += std::visit([&](const auto& shape) {
                 return collide_blocks(state, shape, c.friction, thickness, broad_phase, blocks, cloth, c.kind(), threads,
-                                      profile);
+                                      profile, surface);
             }, c.shape);
         }
     }

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "collision/broad_phase.hpp"
+#include "clothsim/collider_motion.hpp"
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 #include "clothsim/step_profile.hpp"
@@ -91,8 +92,13 @@ struct CollisionBlocks {
 // here by `motion` (null: the caller has kept it since the sweep); when it may reach one of them, or cannot
 // be grown (bounds that are not finite), the stage makes whole boxes itself.
 inline constexpr std::size_t kParallelCollisionParticles = 1024;
+//
+// `surfaces`, when not null, holds one SurfaceMotion per collider (collider_motion.hpp): a collider whose
+// motion moves is met with the particles' motion relative to its surface, its shape already posed at the
+// substep's end by the caller.
 bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_phase, CollisionBlocks& blocks,
-                   StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr);
+                   StepProfile* profile, int threads = 1, const MotionBounds* motion = nullptr,
+                   const SurfaceMotion* surfaces = nullptr);
 
 // What the fast solver's sweep should compute of each block for the next substep's collision stage: Lowest
 // when planes are the only colliders, or when the carried box is valid and out of reach of every solid shape;

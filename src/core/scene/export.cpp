@@ -46,7 +46,7 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
     if (colliders) {
         // Each collider after the cloth: its vertices continue the file's numbering; no texture coordinates.
         std::size_t first = vertices.size() + 1;
-        const std::vector<Collider>& shapes = sim.settings().colliders.shapes;
+        const std::vector<Collider>& shapes = sim.colliders();
         for (std::size_t i = 0; i < shapes.size(); ++i) {
             if (!shapes[i].enabled) continue;
             std::optional<TriangleMesh> mesh;

@@ -3,6 +3,7 @@
 #include "clothsim/scene.hpp"
 
 #include "scene/cloth_shape.hpp"
+#include "clothsim/collider_motion.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
 
@@ -311,6 +312,10 @@ void validate(const Scene& scene) {
                                      " = ", format_value(f), " is out of range; allowed: ", describe_allowed(f)));
             }
         }
+        if (const auto problem = spin_problem(collider)) {
+            throw SceneError(cat("colliders.shapes[", std::to_string(i), "] (", kind_name(collider), "): spin = ",
+                                 format_ref(ConstFieldRef(&collider.motion.spin)), ": ", *problem));
+        }
         if (const auto* mesh = std::get_if<MeshCollider>(&collider.shape); mesh && !mesh->mesh) {
             throw SceneError(cat("colliders.shapes[", std::to_string(i), "] (mesh): file = \"", mesh->file,
                                  "\" holds no mesh; allowed: a Wavefront OBJ file that loads"));
@@ -371,6 +376,8 @@ std::vector<ColliderField> collider_fields(Collider& collider) {
     std::vector<ColliderField> rows = {
         {"enabled", "", 0, 0, "collide with it (false keeps it in the scene, without contact)", &collider.enabled},
         {"friction", "", 0, 10, "Coulomb friction coefficient (0 = frictionless)", &collider.friction},
+        {"velocity", "m/s", -kMaxColliderSpeed, kMaxColliderSpeed, "moves it at this velocity from its pose at time 0 (a kinematic collider: the cloth does not push it)", &collider.motion.velocity},
+        {"spin", "degrees/s", -kMaxColliderSpin, kMaxColliderSpin, "turns it about its centre at these rates of its angles about x, y, z (a sphere, a cylinder about y and a plane about y: only their surface moves; a box: none)", &collider.motion.spin},
     };
     std::visit([&]<class Shape>(Shape& shape) {
         for (const ShapeField<Shape>& f : Shape::fields()) {

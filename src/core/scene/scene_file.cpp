@@ -693,10 +693,14 @@ std::string to_toml(const Scene& scene) {
         }
         out += text;
     }
-    // The colliders, one [[colliders.shapes]] entry each, every field written.
+    // The colliders, one [[colliders.shapes]] entry each, every field written (the motion only for one that
+    // moves: a still object's entry reads as before).
     for (Collider collider : scene.settings.colliders.shapes) {
         out += "\n[[colliders.shapes]]\nkind = \"" + std::string(kind_name(collider)) + "\"\n";
-        for (const ColliderField& f : collider_fields(collider)) out += std::string(f.name) + " = " + format_value(f) + "\n";
+        for (const ColliderField& f : collider_fields(collider)) {
+            if ((f.name == "velocity" || f.name == "spin") && !collider.motion.moves()) continue;
+            out += std::string(f.name) + " = " + format_value(f) + "\n";
+        }
     }
     return out;
 }

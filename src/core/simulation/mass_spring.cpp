@@ -1,5 +1,6 @@
 #include "simulation/mass_spring_internals.hpp"
 
+#include "clothsim/collider_motion.hpp"
 #include "collision/colliders.hpp"
 #include "model/tearing.hpp"
 #include "model/tethers.hpp"
@@ -58,6 +59,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     whole_cells_ = whole_cells(topology_, n);
     surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
     replan();
+    track_collider_motion();
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
                                      : std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()),
             substep_length());
@@ -147,11 +149,46 @@ void MassSpring::apply(const SimulationSettings& settings) {
     settings_ = settings;
     if (in_->grab) in_->grab->force_limit = grab_force_limit(in_->grab->particle);  // it follows the springs' k
     replan();
+    track_collider_motion();
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
     // Self-collision's list and budget say nothing of what the cloth did while the stage was off or set
     // otherwise: it tests afresh at its next substep.
     if (in_->self_collision) in_->self_collision->invalidate();
     setup_stamp_ = next_stamp();
+}
+
+// Whether a collider moves, and the posed list made to match the settings' (collider_motion.hpp).
+void MassSpring::track_collider_motion() {
+    const auto& shapes = settings_.colliders.shapes;
+    in_->colliders_move = colliders_move(settings_.colliders);
+    if (!in_->colliders_move) {
+        in_->posed = ColliderSettings{};
+        in_->surfaces.clear();
+        return;
+    }
+    in_->posed = settings_.colliders;
+    in_->surfaces.assign(shapes.size(), SurfaceMotion{});
+    pose_colliders(state_.time, state_.time);
+}
+
+// The moving colliders posed at t1, and their surfaces' motion over [t0, t1].
+void MassSpring::pose_colliders(double t0, double t1) const {
+    const auto& shapes = settings_.colliders.shapes;
+    for (std::size_t i = 0; i < shapes.size(); ++i) {
+        if (!shapes[i].motion.moves()) continue;
+        pose_at(shapes[i], t1, in_->posed.shapes[i]);
+        in_->surfaces[i] = surface_motion(shapes[i], t0, t1);
+    }
+    in_->posed_time = t1;
+}
+
+const ColliderSettings& MassSpring::colliders_now() const {
+    return in_->colliders_move ? in_->posed : settings_.colliders;
+}
+
+const std::vector<Collider>& MassSpring::colliders() const {
+    if (in_->colliders_move && in_->posed_time != state_.time) pose_colliders(state_.time, state_.time);
+    return colliders_now().shapes;
 }
 
 void MassSpring::set_substeps(int substeps) {
@@ -170,6 +207,7 @@ void MassSpring::substep() {
         return;
     }
     StepProfile* profile = profiling_ ? &profile_ : nullptr;
+    if (in_->colliders_move) pose_colliders(state_.time, state_.time + h);
     in_->blocks.positions_moving();
     const Integrator integrator = settings_.integration.integrator;
     if (h != state_.substep || integrator != state_.integrator) restart(velocities_in_double(), h);
@@ -268,7 +306,7 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
         external = &grab_external_;
     }
     const bool boxes = plan_.colliders && settings_.solver.broad_phase;
-    if (boxes) in_->blocks.bounds = block_bounds_for(settings_.colliders, in_->blocks);
+    if (boxes) in_->blocks.bounds = block_bounds_for(colliders_now(), in_->blocks);
     {
         StageTimer timer(profile, Stage::Fast);
         in_->fast->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &in_->blocks.boxes : nullptr,
@@ -320,7 +358,7 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile) {
     StageTimer timer(profile, Stage::BroadPhase);
     const int cols = topology_.cols;
     const std::size_t per_row = blocks_per_row(cols);
-    const BlockBounds bounds = block_bounds_for(settings_.colliders, in_->blocks);
+    const BlockBounds bounds = block_bounds_for(colliders_now(), in_->blocks);
     in_->blocks.bounds = bounds;
     in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * per_row);
     in_->fast->for_each_band([&](int, int begin, int end) {
@@ -342,8 +380,8 @@ bool MassSpring::collide(StepProfile* profile, const MotionBounds* motion) {
         in_->blocks.moved_outside_motion();  // not grown while no stage reads it
         return false;
     }
-    return collide_stage(state_, settings_.colliders, settings_.solver.broad_phase, in_->blocks, profile, solver_threads(),
-                         motion);
+    return collide_stage(state_, colliders_now(), settings_.solver.broad_phase, in_->blocks, profile, solver_threads(),
+                         motion, in_->colliders_move ? in_->surfaces.data() : nullptr);
 }
 
 // The cloth against itself (self_collision.hpp), built the first time it runs.
@@ -509,7 +547,7 @@ void MassSpring::add_external_forces(const State& state, Vec3Array& force, Vec3A
     }
     if (plan_.contact) {
         StageTimer timer(profile, Stage::Contact);
-        accumulate_contact_forces(state, settings_.colliders, scratch);
+        accumulate_contact_forces(state, colliders_now(), scratch);
     }
     if (plan_.soft_clips && holds) {
         StageTimer timer(profile, Stage::SoftClips);
@@ -639,7 +677,7 @@ Energy MassSpring::energy() const {
         e.gravity_potential -= m * glm::dot(g, state_.position.get(i));
     }
     e.spring_potential = spring_potential_energy(topology_, state_.position, settings_.springs);
-    if (plan_.contact) e.contact_potential = contact_potential_energy(state_, settings_.colliders);
+    if (plan_.contact) e.contact_potential = contact_potential_energy(state_, colliders_now());
     return e;
 }
 

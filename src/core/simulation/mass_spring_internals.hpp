@@ -37,6 +37,12 @@ struct MassSpring::Internals {
     SleepMonitor sleep;
     std::optional<GrabSpring> grab;
     std::vector<PinTarget> pin_targets;  // pins dragged toward a target (drag_pin), at most a few
+    // Kinematic colliders (collider_motion.hpp): while one of the settings' colliders moves, `posed` holds the
+    // list posed at `posed_time` and `surfaces` each one's surface motion over the substep ending then.
+    bool colliders_move = false;
+    ColliderSettings posed;
+    double posed_time = 0.0;
+    std::vector<SurfaceMotion> surfaces;
 
 
     // The stiffness, the substep, the pins or the topology changed: the projective solver factorises again and

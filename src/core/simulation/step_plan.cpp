@@ -1,5 +1,7 @@
 #include "clothsim/step_plan.hpp"
 
+#include "clothsim/collider_motion.hpp"
+
 #include <algorithm>
 #include <array>
 #include <initializer_list>
@@ -78,7 +80,7 @@ StepPlan plan_step(const Topology& topology, const SimulationSettings& settings,
     plan.speed_limit = settings.forces.max_speed > 0.0f;
     plan.tear = settings.springs.tear_strain > 0.0f;
     plan.self_collision = settings.collision.self;
-    plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f);
+    plan.may_sleep = settings.solver.sleep_speed > 0.0f && settings.forces.wind == glm::vec3(0.0f) && !colliders_move(c);
     return plan;
 }
 
@@ -190,8 +192,10 @@ std::vector<StageStatus> describe(const StepPlan& plan, const Topology& topology
     out.push_back({Stage::Tear, when(plan.tear, Skipped),
                    plan.tear ? "once per step" : "springs.tear_strain is 0"});
     out.push_back({Stage::Sleep, when(plan.may_sleep, Skipped),
-                   plan.may_sleep ? "" : (settings.solver.sleep_speed > 0.0f ? "forces.wind keeps it awake"
-                                                                             : "solver.sleep_speed is 0")});
+                   plan.may_sleep ? ""
+                   : settings.solver.sleep_speed <= 0.0f    ? "solver.sleep_speed is 0"
+                   : colliders_move(settings.colliders)     ? "a moving collider keeps it awake"
+                                                            : "forces.wind keeps it awake"});
     return out;
 }
 

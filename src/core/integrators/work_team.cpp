@@ -73,11 +73,17 @@ void WorkTeam::run_job(int threads, int count, void* work, Call call) {
     work_ = work;
     call_ = call;
     const std::uint32_t job = job_.load(std::memory_order_relaxed) + 1;
-    count_[job % 2].store(count, std::memory_order_relaxed);
+    for (int w = 0; w < threads; ++w) {
+        const long long begin = static_cast<long long>(w) * count / threads;
+        ends_[job % 2][w].store(static_cast<int>(static_cast<long long>(w + 1) * count / threads), std::memory_order_relaxed);
+        ranges_[w].claim.store(static_cast<std::uint64_t>(job) << 32 | static_cast<std::uint64_t>(begin),
+                               std::memory_order_release);
+    }
+    ranges_used_[job % 2].store(threads, std::memory_order_relaxed);
+    total_[job % 2].store(count, std::memory_order_relaxed);
     helpers_wanted_.store(threads - 1, std::memory_order_relaxed);
     done_.store(0, std::memory_order_relaxed);
-    claim_.store(static_cast<std::uint64_t>(job) << 32, std::memory_order_release);
-    job_.store(job);  // sequentially consistent with the sleepers' count (helper_loop)
+    job_.store(job);  // sequentially consistent with the sleepers' count (helper_loop); publishes the ranges
     if (sleepers_.load() > 0) futex_wake_all(job_);
     work_on(job, 0);
     for (int spin = 0;; ++spin) {
@@ -97,18 +103,25 @@ void WorkTeam::run_job(int threads, int count, void* work, Call call) {
 }
 
 void WorkTeam::work_on(std::uint32_t job, int worker) {
-    for (;;) {
-        std::uint64_t claim = claim_.load(std::memory_order_acquire);
-        if (static_cast<std::uint32_t>(claim >> 32) != job) return;  // the job has moved on
-        const int index = static_cast<int>(static_cast<std::uint32_t>(claim));
-        const int count = count_[job % 2].load(std::memory_order_relaxed);
-        if (index >= count) return;
-        if (!claim_.compare_exchange_weak(claim, claim + 1, std::memory_order_acq_rel, std::memory_order_acquire)) {
-            continue;
+    // Its own range first, then the others' in turn.
+    const int ranges = ranges_used_[job % 2].load(std::memory_order_relaxed);
+    for (int k = 0; k < ranges; ++k) {
+        Range& range = ranges_[(worker + k) % ranges];
+        const int end = ends_[job % 2][(worker + k) % ranges].load(std::memory_order_relaxed);
+        for (;;) {
+            std::uint64_t claim = range.claim.load(std::memory_order_acquire);
+            if (static_cast<std::uint32_t>(claim >> 32) != job) return;  // the job has moved on
+            const int index = static_cast<int>(static_cast<std::uint32_t>(claim));
+            if (index >= end) break;  // this range is taken: the next
+            if (!range.claim.compare_exchange_weak(claim, claim + 1, std::memory_order_acq_rel, std::memory_order_acquire)) {
+                continue;
+            }
+            // Holding an index of `job`, which cannot finish before it has run: work_, call_ and the ends are
+            // its own.
+            call_(work_, index, worker);
+            const int count = total_[job % 2].load(std::memory_order_relaxed);
+            if (done_.fetch_add(1) + 1 == count && caller_asleep_.load()) futex_wake_all(done_);
         }
-        // Holding an index of `job`, which cannot finish before it has run: work_ and call_ are its own.
-        call_(work_, index, worker);
-        if (done_.fetch_add(1) + 1 == count && caller_asleep_.load()) futex_wake_all(done_);
     }
 }
 

@@ -14,7 +14,9 @@
 #include "clothsim/shapes/sphere.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <variant>
@@ -33,6 +35,7 @@ inline constexpr double kMaxColliderSpin = 3600.0;  // degrees/s: ten turns a se
 struct ColliderMotion {
     glm::vec3 velocity{0.0f};  // m/s
     glm::vec3 spin{0.0f};      // degrees/s: the rates of the rotation angles about x, y and z (R = Rz Ry Rx)
+    double stop = INFINITY;    // s: the time it stops where it has got to (a drag's move: MassSpring::move_collider)
     bool moves() const { return velocity != glm::vec3(0.0f) || spin != glm::vec3(0.0f); }
     bool operator==(const ColliderMotion&) const = default;
 };
@@ -84,6 +87,20 @@ inline ShapeDrawing drawing(const Collider& c) {
 }
 inline Box bounds(const Collider& c) {
     return std::visit([](const auto& s) { return bounds(s); }, c.shape);
+}
+
+// Where the segment from -> to first enters the solid, as a fraction of the way, if it does (the swept test
+// of the contact with no thickness): what the app's alt+drag picks an object by. A half-space (the ground)
+// is never picked.
+inline std::optional<double> segment_entry(const Collider& c, glm::dvec3 from, glm::dvec3 to) {
+    if (is_half_space(c)) return std::nullopt;
+    return std::visit(
+        [&](const auto& s) -> std::optional<double> {
+            const auto hit = swept_hit(placed(s, 0.0f), from, to, 0.0);
+            if (!hit) return std::nullopt;
+            return hit->t;
+        },
+        c.shape);
 }
 
 }  // namespace clothsim

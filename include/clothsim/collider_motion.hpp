@@ -66,6 +66,7 @@ inline glm::dmat3 orientation(const Collider& c, double t) {
 // Writes into `out` (a copy of `base`, of the same kind) the pose of `base` at time t. Only the pose's fields
 // are written, so updating a copy each substep allocates nothing.
 inline void pose_at(const Collider& base, double t, Collider& out) {
+    t = std::min(t, base.motion.stop);
     const glm::dvec3 moved = glm::dvec3(base.motion.velocity) * t;
     std::visit(
         [&](auto& s) {
@@ -97,6 +98,8 @@ struct SurfaceMotion {
     glm::dvec3 displacement(glm::dvec3 p) const { return p - (pivot_start + back * (p - pivot_end)); }
 };
 inline SurfaceMotion surface_motion(const Collider& c, double t0, double t1) {
+    t0 = std::min(t0, c.motion.stop);
+    t1 = std::min(t1, c.motion.stop);
     const glm::dvec3 p0 = pivot(c), v(c.motion.velocity);
     const glm::dvec3 w(c.motion.spin);
     SurfaceMotion m;
@@ -115,6 +118,34 @@ inline SurfaceMotion surface_motion(const Collider& c, double t0, double t1) {
     }
     m.reach = m.reach * (1.0 + 1e-6) + 1e-9;  // rounding room, as the shapes' margins
     return m;
+}
+
+// Moves a collider's pose (its centre; a mesh's position; a plane's height by by.y).
+inline void translate(Collider& c, glm::dvec3 by) {
+    std::visit(
+        [&](auto& s) {
+            using Shape = std::decay_t<decltype(s)>;
+            if constexpr (std::is_same_v<Shape, MeshCollider>) {
+                s.position = glm::vec3(glm::dvec3(s.position) + by);
+            } else if constexpr (std::is_same_v<Shape, PlaneCollider>) {
+                s.height = static_cast<float>(double(s.height) + by.y);
+            } else {
+                s.center = glm::vec3(glm::dvec3(s.center) + by);
+            }
+        },
+        c.shape);
+}
+
+// The same collider with another velocity and stop time from time t on: the fields (its pose at time 0) are
+// shifted so that its pose at t stays where `c` is then; its spin goes on.
+inline Collider with_velocity(const Collider& c, double t, glm::vec3 velocity, double stop) {
+    Collider now = c;
+    pose_at(c, t, now);  // its pose at t, as fields
+    now.motion = ColliderMotion{velocity, c.motion.spin, INFINITY};
+    Collider out = now;
+    pose_at(now, -t, out);  // back to time 0 along the new motion
+    out.motion.stop = stop;
+    return out;
 }
 
 // Why a collider's spin cannot be followed by its shape, or nothing: a box stays axis-aligned, a cylinder

@@ -75,6 +75,12 @@ public:
     // The colliders where they are now: the settings' list, with each moving one (collider_motion.hpp) posed at
     // the simulation's time. What the renderer draws and the contact meets.
     const std::vector<Collider>& colliders() const;
+    // Drags collider i (the app's alt+drag): from where it is now it moves in a straight line to `to` (its
+    // centre; a mesh: its position), arriving `seconds` of simulated time from now, and stops there; the
+    // contact meets it with that velocity, so the cloth it touches is pushed and carried by friction. Its
+    // spin goes on. With seconds <= 0 it is put at `to` at rest (the end of a drag, or a move while paused).
+    // Returns false (and changes nothing) when there is no collider i or `to` is not finite.
+    bool move_collider(std::size_t i, glm::vec3 to, double seconds);
     // The one way to change the live settings: takes effect at the next substep. A change replans the stages
     // (step_plan.hpp), wakes the cloth (a moved collider, wind or a slider drives it) and moves
     // setup_stamp(); applying the settings already in force does nothing.

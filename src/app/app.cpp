@@ -2,6 +2,8 @@
 // simulation at a fixed dt, draw the scene, draw the panel, act on what the panel asked.
 #include "app.hpp"
 
+#include "clothsim/collider_motion.hpp"
+
 #include "app_state.hpp"
 #include "camera.hpp"
 #include "frame_log.hpp"
@@ -82,6 +84,7 @@ void record_energy(AppState& app) {
 // What a new cloth resets: the grab, the time owed, the plots, the renderer's buffers.
 void after_rebuild(AppState& app, Renderer& renderer) {
     app.grab.reset();
+    app.object_drag.reset();
     app.stepper.restart();
     app.stats.speed = app.time_scale;
     app.stats.window_wall = app.stats.window_simulated = 0.0;
@@ -187,11 +190,15 @@ bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
     return restart;
 }
 
+// The ray through a point of the window (pixels from its top-left), and through the cursor.
+Ray ray_at(const AppState& app, const Window& window, float scale, glm::dvec2 at) {
+    const glm::vec4 r = view_rect(app, window, scale);
+    return ray_through(app.camera, glm::vec2(at.x - r.x, at.y - r.y), glm::vec2(r.z, r.w));
+}
 Ray cursor_ray(const AppState& app, const Window& window, float scale) {
     double x = 0.0, y = 0.0;
     glfwGetCursorPos(window.get(), &x, &y);
-    const glm::vec4 r = view_rect(app, window, scale);
-    return ray_through(app.camera, glm::vec2(x - r.x, y - r.y), glm::vec2(r.z, r.w));
+    return ray_at(app, window, scale, {x, y});
 }
 
 // Converts the pins of the running simulation to the scene's explicit list, so "Save scene" keeps them. Soft
@@ -258,10 +265,56 @@ void cut_along_stroke(AppState& app, const Window& window, float scale, glm::vec
     if (broken > 0) app.say("cut " + std::to_string(broken) + " springs");
 }
 
+// The object under the cursor (alt + click): the nearest enabled collider the cursor's ray enters, and where.
+std::optional<ObjectDrag> pick_object(const AppState& app, const Ray& ray) {
+    const glm::dvec3 from(ray.origin), to = from + glm::dvec3(ray.direction) * kShapeReach;
+    std::optional<ObjectDrag> best;
+    double nearest = INFINITY;
+    const std::vector<Collider>& list = app.sim.colliders();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        if (!list[i].enabled) continue;
+        const auto t = segment_entry(list[i], from, to);
+        if (!t || *t >= nearest) continue;
+        nearest = *t;
+        best = ObjectDrag{i, glm::vec3(from + *t * (to - from)), -app.camera.forward(), glm::vec3(pivot(list[i]))};
+    }
+    return best;
+}
+
+// Alt + left-drag moves an object in the plane facing the camera: the simulation moves it toward the cursor
+// over the time this frame will simulate (MassSpring::move_collider), so the cloth it touches is pushed and
+// carried with that velocity; released, it stays where it got to. While paused it is put there at once.
+void drag_object(AppState& app, const Window& window, float scale) {
+    const ObjectDrag& drag = *app.object_drag;
+    const auto p = intersect_plane(cursor_ray(app, window, scale), drag.plane_point, drag.plane_normal);
+    if (!p) return;
+    const double dt = app.sim.settings().integration.dt;
+    const double seconds = app.paused ? 0.0 : std::max(dt, 1e-3 * app.stats.frame_ms * app.time_scale);
+    app.sim.move_collider(drag.collider, drag.start + (*p - drag.plane_point), seconds);
+}
+
+void release_object(AppState& app) {
+    const std::size_t i = app.object_drag->collider;
+    app.object_drag.reset();
+    const std::vector<Collider>& list = app.sim.colliders();
+    if (i >= list.size()) return;
+    const glm::vec3 at(pivot(list[i]));
+    app.sim.move_collider(i, at, 0.0);
+    char line[160];
+    std::snprintf(line, sizeof line, "collider %zu (%s) moved to (%.3g, %.3g, %.3g)", i,
+                  std::string(kind_name(list[i])).c_str(), at.x, at.y, at.z);
+    app.say(line);
+}
+
 void handle_mouse(AppState& app, const Window& window, float scale) {
     const ImGuiIO& io = ImGui::GetIO();
     const glm::vec2 delta(io.MouseDelta.x, io.MouseDelta.y);
     const float height = static_cast<float>(window.window_size().y);
+    if (app.object_drag) {
+        if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) drag_object(app, window, scale);
+        else release_object(app);
+        return;
+    }
     if (app.grab) {
         if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
             drag_grabbed(app, window, scale);
@@ -275,6 +328,11 @@ void handle_mouse(AppState& app, const Window& window, float scale) {
     if (io.KeyShift && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
         const glm::vec2 to(io.MousePos.x, io.MousePos.y);
         cut_along_stroke(app, window, scale, to - delta, to);
+        return;
+    }
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && io.KeyAlt) {
+        app.object_drag = pick_object(app, cursor_ray(app, window, scale));
+        if (!app.object_drag) app.say("alt + drag moves an object: there is none under the cursor");
         return;
     }
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && !io.KeyShift) {
@@ -324,6 +382,12 @@ struct InputQueue {
     std::vector<std::string> dropped;  // paths dropped onto the window since the last frame
     GLFWkeyfun imgui_key = nullptr;    // ImGui's key callback, which this queue feeds
     GLFWmousebuttonfun imgui_mouse_button = nullptr;  // ... and its mouse button callback
+    GLFWcursorposfun imgui_cursor = nullptr;          // ... and its cursor callback
+    // Where the cursor was last reported, a drag-and-drop's position included (GLFW reports XdndPosition as
+    // a cursor move; glfwGetCursorPos asks the X server for the pointer, which a drop does not move), and
+    // where it was when files were dropped.
+    glm::dvec2 cursor{NAN, NAN};
+    glm::dvec2 dropped_at{NAN, NAN};
     struct Release {
         int key, scancode, mods;
     };
@@ -366,11 +430,21 @@ void release_held_keys(GLFWwindow* window, InputQueue& queue) {
 
 void on_drop(GLFWwindow* window, int count, const char** paths) {
     auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
-    for (int i = 0; queue && i < count; ++i) queue->dropped.emplace_back(paths[i]);
+    if (!queue) return;
+    for (int i = 0; i < count; ++i) queue->dropped.emplace_back(paths[i]);
+    queue->dropped_at = queue->cursor;
 }
 
-// Files dropped onto the window: the first .toml opens as "Open file" would; the others are refused, said why.
-void handle_drop(AppState& app, InputQueue& input, PanelRequests& requests) {
+void on_cursor(GLFWwindow* window, double x, double y) {
+    auto* queue = static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
+    if (!queue) return;
+    queue->cursor = {x, y};
+    if (queue->imgui_cursor) queue->imgui_cursor(window, x, y);
+}
+
+// Files dropped onto the window: the first .toml opens as "Open file" would; .obj files are added as mesh
+// colliders under the cursor; the others are refused, said why.
+void handle_drop(AppState& app, const Window& window, float scale, InputQueue& input, PanelRequests& requests) {
     if (input.dropped.empty()) return;
     if (app.dialogs.open()) {  // the dialog's answer would land on top of the dropped scene
         app.say("dropped files not opened: a file dialog is open; close it first", true);
@@ -380,7 +454,27 @@ void handle_drop(AppState& app, InputQueue& input, PanelRequests& requests) {
     const DropChoice choice = choose_dropped_scene(input.dropped);
     input.dropped.clear();
     for (const std::string& why : choice.refused) app.say(why, true);
-    if (choice.open) requests.load = choice.open;
+    if (choice.open) {
+        requests.load = choice.open;  // a new scene: the meshes dropped with it would land in the old one
+        for (const std::string& mesh : choice.meshes) app.say("dropped " + mesh + ": not added: a scene was dropped with it", true);
+        return;
+    }
+    // Meshes land under the cursor on the floor (the first plane that collides, else y = 0), or 2 m in front
+    // of the camera when the cursor is above the horizon.
+    float floor = 0.0f;
+    for (const Collider& c : app.sim.colliders()) {
+        if (const auto* plane = std::get_if<PlaneCollider>(&c.shape); plane && c.enabled) {
+            floor = plane->height;
+            break;
+        }
+    }
+    const Ray ray = std::isfinite(input.dropped_at.x) ? ray_at(app, window, scale, input.dropped_at) : cursor_ray(app, window, scale);
+    const auto on_floor = intersect_plane(ray, glm::vec3(0.0f, floor, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+    const glm::vec3 at = on_floor && glm::distance(*on_floor, ray.origin) < 100.0f ? *on_floor : ray.origin + 2.0f * ray.direction;
+    for (const std::string& mesh : choice.meshes) {
+        const std::string said = add_dropped_mesh(mesh, at, app.sim);
+        app.say(said, !said.starts_with("added"));
+    }
 }
 
 void handle_keys(AppState& app, InputQueue& input, PanelRequests& requests) {
@@ -603,6 +697,7 @@ void start_imgui(const Window& window, InputQueue& input, float scale) {
     // In front of ImGui's key and mouse button callbacks, which the queue then feeds (InputQueue).
     input.imgui_key = glfwSetKeyCallback(window.get(), on_key);
     input.imgui_mouse_button = glfwSetMouseButtonCallback(window.get(), on_mouse_button);
+    input.imgui_cursor = glfwSetCursorPosCallback(window.get(), on_cursor);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 }
 
@@ -805,7 +900,7 @@ int main_loop(Window& window, Renderer& renderer, AppState& app, const AppOption
 
         PanelRequests requests;
         handle_keys(app, input, requests);
-        handle_drop(app, input, requests);
+        handle_drop(app, window, scale, input, requests);
         poll_file_dialog(app, requests);
         handle_mouse(app, window, scale);
         const auto now = Clock::now();

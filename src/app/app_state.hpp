@@ -117,6 +117,15 @@ struct Grab {
     glm::vec3 plane_normal{0.0f, 0.0f, 1.0f};
 };
 
+// An object being moved (alt + left-drag): collider `collider`, picked at `plane_point` on its surface, moves
+// with the cursor in the plane through that point facing the camera.
+struct ObjectDrag {
+    std::size_t collider = 0;
+    glm::vec3 plane_point{0.0f};
+    glm::vec3 plane_normal{0.0f, 0.0f, 1.0f};
+    glm::vec3 start{0.0f};  // the collider's centre (a mesh: its position) when picked
+};
+
 // A recording in progress: every drawn frame written as DIR/frame-NNNNNN.png (one step of integration.dt
 // per frame, so the frames play back at 1 / dt frames per second in real time).
 struct Recording {
@@ -157,6 +166,7 @@ struct AppState {
     bool vsync = true;
     Stats stats;
     std::optional<Grab> grab;
+    std::optional<ObjectDrag> object_drag;
     Messages messages;         // what the app tells the user (errors, notes, screenshot paths)
     FileDialogs dialogs;       // "Open file..." and "Save scene as..."
     RecentFiles recent{std::filesystem::path()};  // the Recent menu (read from the config folder by the app)

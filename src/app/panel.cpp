@@ -501,7 +501,9 @@ void help_section() {
     ImGui::BulletText("wheel: zoom");
     ImGui::BulletText("left-drag on the cloth: grab a particle");
     ImGui::BulletText("ctrl+click on the cloth: pin / unpin a particle");
+    ImGui::BulletText("alt+left-drag on an object: move it (it pushes and carries the cloth)");
     ImGui::BulletText("drop a .toml file onto the window: open it");
+    ImGui::BulletText("drop an .obj file: add it as an object under the cursor");
     ImGui::TextUnformatted("Keys");
     ImGui::BulletText("Space: pause / play      S: single step");
     ImGui::BulletText("R: reset the scene       W: wireframe");

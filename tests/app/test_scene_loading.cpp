@@ -5,6 +5,9 @@
 #include "per_spring_scenes.hpp"
 #include "support.hpp"
 
+#include "clothsim/mesh_file.hpp"
+#include "clothsim/mesh_shapes.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -162,4 +165,26 @@ TEST_CASE("a dropped scene that does not load changes nothing the user has") {
     REQUIRE(error);
     CHECK_THAT(*error, Contains("bad.toml") && Contains("cloth.rows"));
     check_untouched(s, positions, time);
+}
+
+TEST_CASE("a dropped .obj becomes a mesh collider standing on the floor at the given point; a bad one is refused by line") {
+    const clothsim::test::TempDir dir("drop_mesh");
+    const std::filesystem::path crate = dir / "Crate.OBJ", bad = dir / "bad.obj";
+    clothsim::write_mesh_file(clothsim::box_mesh(glm::dvec3(0.4, 0.3, 0.2)), crate, "a crate");
+    std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
+    const DropChoice choice = choose_dropped_scene({crate.string(), (dir / "note.txt").string(), bad.string()});
+    CHECK(!choice.open);
+    CHECK(choice.meshes == std::vector<std::string>{crate.string(), bad.string()});  // the extension in any case
+    REQUIRE(choice.refused.size() == 1);
+    Session s;
+    const std::size_t before = s.sim.settings().colliders.shapes.size();
+    const std::string added = add_dropped_mesh(crate.string(), glm::vec3(1.0f, 0.0f, -0.5f), s.sim);
+    CHECK_THAT(added, Contains("added") && Contains("12 triangles"));
+    REQUIRE(s.sim.settings().colliders.shapes.size() == before + 1);
+    const auto& mesh = std::get<clothsim::MeshCollider>(s.sim.settings().colliders.shapes.back().shape);
+    CHECK(mesh.position == glm::vec3(1.0f, 0.15f, -0.5f));  // the box's lowest point on the floor, centred there
+    CHECK(std::filesystem::path(mesh.file).is_absolute());
+    const std::string refused = add_dropped_mesh(bad.string(), glm::vec3(0.0f), s.sim);
+    CHECK_THAT(refused, Contains("bad.obj") && Contains(":3") && Contains("not added"));
+    CHECK(s.sim.settings().colliders.shapes.size() == before + 1);
 }

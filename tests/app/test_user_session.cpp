@@ -8,6 +8,8 @@
 #include "screen.hpp"
 #include "user_session.hpp"
 
+#include "clothsim/mesh_file.hpp"
+#include "clothsim/mesh_shapes.hpp"
 #include "clothsim/scene.hpp"
 
 #include <catch2/catch.hpp>
@@ -713,4 +715,54 @@ TEST_CASE("user session: the Colliders section adds a box, removes the ground an
     CHECK(sphere->radius > 0.35f);  // dragged larger than the scene's
     CHECK(*box == clothsim::BoxCollider{});  // a new box has the defaults
     CHECK(shapes[1].enabled);
+}
+
+TEST_CASE("user session: alt + drag moves the sphere under a falling cloth, which it carries; Save keeps where it went") {
+    const clothsim::Scene scene = clothsim::load_scene("drape-sphere");
+    const clothsim::MassSpring sim = clothsim::build_simulation(scene);
+    const glm::vec3 sphere = to_screen(start_camera(sim), glm::vec3(0.0f, 0.5f, 0.0f));
+    const TempDir dir("session_move_object");
+    // The sphere dragged 150 px to the right while the cloth falls onto it; an alt+click on the sky picks nothing.
+    const RunResult r = run_user_session(
+        dir, {"--scene", "drape-sphere"},
+        "alt_drag " + at_xy(sphere) + " " + std::to_string(int(sphere.x) + 150) + " " + std::to_string(int(sphere.y)) +
+            "\nalt_drag 900 40 950 40\nclick " + kSave + "\nwait_for drape-sphere-edited.toml\nquit\n",
+        zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, !Contains("guard"));
+    const clothsim::Scene saved = reopen_saved(dir, "drape-sphere-edited.toml");
+    const auto* moved = std::get_if<clothsim::SphereCollider>(&saved.settings.colliders.shapes.at(0).shape);
+    REQUIRE(moved);
+    INFO("sphere saved at " << moved->center.x << ", " << moved->center.y << ", " << moved->center.z);
+    CHECK(moved->center.x > 0.2f);                          // to the right on screen: +x from the start camera
+    CHECK(std::abs(moved->center.y - 0.5f) < 0.15f);         // in the plane facing the camera
+    CHECK(saved.settings.colliders.shapes[0].motion == clothsim::ColliderMotion{});  // at rest where it went
+}
+
+TEST_CASE("user session: an .obj dropped onto the window stands on the floor under the cursor; a bad one is refused") {
+    const TempDir dir("session_drop_mesh");
+    const fs::path crate = dir / "crate.obj", bad = dir / "bad.obj";
+    clothsim::write_mesh_file(clothsim::box_mesh(glm::dvec3(0.4, 0.3, 0.2)), crate, "a crate");
+    std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
+    const RunResult r = run_user_session(dir, {"--scene", "drape-sphere", "--paused"},
+                                         "drop 900 600 " + quote(bad.string()) + " " + quote(crate.string()) + "\nclick " +
+                                             kSave + "\nwait_for drape-sphere-edited.toml\nquit\n",
+                                         zenity_saving_as_proposed(dir));
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, !Contains("drop: not taken"));
+    CHECK_THAT(r.err, Contains("bad.obj") && Contains(":3") && Contains("not added"));  // file and line
+    const clothsim::Scene saved = reopen_saved(dir, "drape-sphere-edited.toml");
+    const std::vector<clothsim::Collider>& shapes = saved.settings.colliders.shapes;
+    REQUIRE(shapes.size() == 3);  // the sphere, the ground, the crate
+    const auto* mesh = std::get_if<clothsim::MeshCollider>(&shapes[2].shape);
+    REQUIRE(mesh);
+    CHECK(mesh->file == crate.string());
+    CHECK(mesh->position.y == Approx(0.15f).margin(1e-4));  // its lowest point on the ground
+    // Under the cursor: the point (900, 600) of the window, on the ground.
+    const clothsim::MassSpring sim = clothsim::build_simulation(clothsim::load_scene("drape-sphere"));
+    const glm::vec3 seen = to_screen(start_camera(sim), glm::vec3(mesh->position.x, 0.0f, mesh->position.z));
+    CHECK(std::abs(seen.x - 900.0f) < 3.0f);
+    CHECK(std::abs(seen.y - 600.0f) < 3.0f);
 }

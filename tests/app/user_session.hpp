@@ -20,6 +20,7 @@ namespace clothsim::test {
 //   ctrl_click X Y       the same with Ctrl held
 //   drag X0 Y0 X1 Y1     left button down at (X0, Y0), moved to (X1, Y1), released
 //   cut X0 Y0 X1 Y1      the same with the right button and Shift held (the knife)
+//   alt_drag X0 Y0 X1 Y1 a left drag with Alt held (moves an object)
 //   shot NAME            an F12 screenshot, saved as NAME (a PNG in the session's directory)
 //   settle               waits until the app has drawn two frames after what came before (frame, twice)
 //   frame                waits until the app has drawn a frame after what came before: F12 asks for a
@@ -52,6 +53,8 @@ drag() { at "$1" "$2"; xdotool mousedown 1; sleep 0.3; xdotool mousemove --windo
          xdotool mouseup 1; settle; }
 cut() { at "$1" "$2"; xdotool keydown shift; sleep 0.2; xdotool mousedown 3; sleep 0.3;
         xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5; xdotool mouseup 3; sleep 0.2; xdotool keyup shift; settle; }
+alt_drag() { at "$1" "$2"; xdotool keydown alt; sleep 0.2; xdotool mousedown 1; sleep 0.3;
+             xdotool mousemove --window "$wid" "$3" "$4"; sleep 0.5; xdotool mouseup 1; sleep 0.2; xdotool keyup alt; settle; }
 quit() { at 900 400; key Escape; }
 title_has() { for _ in $(seq 600); do xdotool getwindowname "$wid" | grep -qF -- "$1" && break; sleep 0.1; done; }
 drop() { local x="$1" y="$2"; shift 2; "$XDND_DROP" "$wid" "$x" "$y" "$@" || echo "drop: not taken" >&2; settle; }

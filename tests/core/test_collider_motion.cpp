@@ -170,3 +170,35 @@ TEST_CASE("collider motion: a moving collider keeps the cloth awake, a still one
     while (moving.time() < 1.0) moving.run_steps(1);
     CHECK_FALSE(moving.asleep());
 }
+
+TEST_CASE("collider motion: a dragged box (move_collider) carries the cloth lying on it by friction, and stays "
+          "where the drag left it") {
+    // A board 1 cm thick under a small cloth, pulled 0.2 m along x over 0.5 s in frame-long moves, as the app's
+    // alt+drag does: its pose follows the drag without a jump, the cloth rides on it, and released, it rests.
+    Scene s = flat_cloth(5, 0.2f, 0.0155f);
+    Collider board = Collider::of(BoxCollider{{0.0f, 0.005f, 0.0f}, {0.6f, 0.01f, 0.6f}});
+    board.friction = 1.0f;
+    s.settings.colliders.shapes = {board};
+    s.settings.integration.substeps = 8;
+    MassSpring sim = build_simulation(s);
+    sim.run_steps(6);  // settled on the board
+    const double start_x = sim.position(12).x;
+    const double dt = s.settings.integration.dt;
+    for (int frame = 1; frame <= 30; ++frame) {
+        const glm::vec3 target(0.2f * frame / 30.0f, 0.005f, 0.0f);
+        REQUIRE(sim.move_collider(0, target, dt));
+        const glm::vec3 before = std::get<BoxCollider>(sim.colliders()[0].shape).center;
+        CHECK(before.x == Approx(0.2f * (frame - 1) / 30.0f).margin(1e-5));  // where the last move took it
+        sim.run_steps(1);
+        CHECK(std::get<BoxCollider>(sim.colliders()[0].shape).center.x == Approx(target.x).margin(1e-5));
+    }
+    REQUIRE(sim.move_collider(0, std::get<BoxCollider>(sim.colliders()[0].shape).center, 0.0));
+    CHECK(sim.settings().colliders.shapes[0].motion == ColliderMotion{});
+    sim.run_steps(30);
+    CHECK(std::get<BoxCollider>(sim.colliders()[0].shape).center.x == Approx(0.2f).margin(1e-5));
+    // The cloth rode along: its middle moved with the board (it speeds up at mu g, 0.4 m/s being reached
+    // within 0.05 s), not left behind.
+    CHECK(sim.position(12).x - start_x == Approx(0.2).margin(0.03));
+    CHECK_FALSE(sim.move_collider(5, glm::vec3(0.0f), 1.0));
+    CHECK_FALSE(sim.move_collider(0, glm::vec3(NAN), 1.0));
+}

@@ -191,6 +191,26 @@ const std::vector<Collider>& MassSpring::colliders() const {
     return colliders_now().shapes;
 }
 
+bool MassSpring::move_collider(std::size_t i, glm::vec3 to, double seconds) {
+    if (i >= settings_.colliders.shapes.size() || !std::isfinite(to.x) || !std::isfinite(to.y) || !std::isfinite(to.z)) {
+        return false;
+    }
+    SimulationSettings s = settings_;
+    Collider& c = s.colliders.shapes[i];
+    const double t = state_.time;
+    Collider now = c;
+    pose_at(c, t, now);
+    const glm::dvec3 shift = glm::dvec3(to) - pivot(now);
+    if (seconds > 0.0) {
+        c = with_velocity(c, t, glm::vec3(shift / seconds), t + seconds);
+    } else {
+        c = with_velocity(c, t, glm::vec3(0.0f), INFINITY);
+        translate(c, shift);
+    }
+    apply(s);
+    return true;
+}
+
 void MassSpring::set_substeps(int substeps) {
     SimulationSettings s = settings_;
     s.integration.substeps = substeps;

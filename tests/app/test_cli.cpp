@@ -336,7 +336,8 @@ TEST_CASE("cli: the text report of a headless run") {
 TEST_CASE("cli: an unknown scene exits 2 and lists the bundled scenes") {
     expect_bad_input({"--headless", "--scene", "no-such-scene"},
                      {"unknown scene", "no-such-scene", "curtain", "drape-cube", "drape-sphere", "falling", "flag",
-                      "hanging", "moving-ball", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
+                      "hanging", "mannequin-drape", "chair-drape", "moving-ball", "stiff-drape", "stiff-hanging",
+                      "tablecloth", "tear"});
 }
 
 TEST_CASE("cli: a bad --set exits 2 and names the field") {
@@ -781,8 +782,9 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CAPTURE_RUN(r);
     CHECK(r.code == 0);
     CHECK(lines_of(r.out) ==
-          std::vector<std::string>{"curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag", "fold",
-                                   "hanging", "moving-ball", "pile", "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
+          std::vector<std::string>{"chair-drape", "curtain", "cusick", "drape-cube", "drape-sphere", "falling", "flag",
+                                   "fold", "hanging", "mannequin-drape", "moving-ball", "pile", "stiff-drape",
+                                   "stiff-hanging", "tablecloth", "tear"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

@@ -263,6 +263,12 @@ TEST_CASE("live tuning: fold takes wind, damping and stretch while it runs", "[e
 TEST_CASE("live tuning: hanging takes wind, damping and stretch while it runs", "[every-scene]") {
     tune_live("hanging", {});
 }
+TEST_CASE("live tuning: mannequin-drape takes wind, damping and stretch while it runs", "[every-scene]") {
+    tune_live("mannequin-drape", {});
+}
+TEST_CASE("live tuning: chair-drape takes wind, damping and stretch while it runs", "[every-scene]") {
+    tune_live("chair-drape", {});
+}
 TEST_CASE("live tuning: moving-ball takes wind, damping and stretch while the ball rolls", "[every-scene]") {
     tune_live("moving-ball", {});
 }

@@ -87,16 +87,17 @@ std::string shortest(double v) {
 // Bundled scenes
 // ---------------------------------------------------------------------------------------------------------
 
-TEST_CASE("scene: the bundled scene list is exactly the fourteen shipped scenes") {
-    const std::vector<std::string> expected = {"curtain", "cusick",      "drape-cube", "drape-sphere", "falling",
-                                               "flag",    "fold",        "hanging",    "moving-ball",  "pile",
+TEST_CASE("scene: the bundled scene list is exactly the sixteen shipped scenes") {
+    const std::vector<std::string> expected = {"chair-drape", "curtain",     "cusick",      "drape-cube",
+                                               "drape-sphere", "falling",    "flag",        "fold",
+                                               "hanging",     "mannequin-drape", "moving-ball", "pile",
                                                "stiff-drape", "stiff-hanging", "tablecloth", "tear"};
     REQUIRE(clothsim::bundled_scene_names() == expected);
 }
 
 TEST_CASE("scene: every bundled scene loads, builds and stays finite for 2 simulated seconds (0.5 s sanitized)") {
     const std::vector<std::string> names = clothsim::bundled_scene_names();
-    REQUIRE(names.size() == 14);
+    REQUIRE(names.size() == 16);
     for (const std::string& name : names) {
         INFO("scene " << name);
         // The costly scenes run the 2 s on a coarser grid (tests/support.hpp), and one step at their own size.

@@ -1,6 +1,7 @@
 // Triangle meshes (clothsim/triangle_mesh.hpp, mesh_shapes.hpp): the hierarchy's queries against a brute-force
 // oracle over every triangle, the pseudonormal's side against the winding number, and the shapes the project
 // makes being closed solids of the right size.
+#include "clothsim/mesh_file.hpp"
 #include "clothsim/mesh_shapes.hpp"
 #include "clothsim/triangle_mesh.hpp"
 
@@ -223,4 +224,45 @@ TEST_CASE("triangle mesh contact grid answers as the tree does, and stays bounde
     const auto on = huge.nearest({1.0, 0.5e-6, 2.0}, 1e-6, *coarse);
     REQUIRE(on);
     CHECK(on->distance == Approx(0.5e-6));
+}
+
+TEST_CASE("triangle mesh isosurface meshes a signed distance as a closed surface on its zero set", "[triangle_mesh]") {
+    // A sphere of radius 0.3 sampled every 2 cm: every vertex on the sphere (a signed distance interpolates
+    // exactly along a grid edge up to its curvature), closed, winding number 1 inside and 0 outside.
+    const TriangleMesh ball = isosurface([](glm::dvec3 p) { return glm::length(p) - 0.3; }, glm::dvec3(-0.35),
+                                         glm::dvec3(0.35), 0.02);
+    CHECK(ball.closed());
+    double worst = 0.0;
+    for (const glm::dvec3& v : ball.vertices()) worst = std::max(worst, std::abs(glm::length(v) - 0.3));
+    CHECK(worst < 2e-3);
+    CHECK(ball.winding_number({0.0, 0.0, 0.0}) == Approx(1.0));
+    CHECK(ball.winding_number({0.0, 0.31, 0.0}) == Approx(0.0).margin(1e-9));
+    // Outward: the face normals point away from the centre.
+    for (std::size_t t = 0; t < ball.triangles().size(); t += 97) {
+        const auto& f = ball.triangles()[t];
+        const glm::dvec3 centre = (ball.vertices()[f[0]] + ball.vertices()[f[1]] + ball.vertices()[f[2]]) / 3.0;
+        CHECK(glm::dot(ball.face_normals()[t], centre) > 0.0);
+    }
+}
+
+TEST_CASE("triangle mesh the mannequin and the chair are closed solids standing on the ground, as bundled",
+          "[triangle_mesh]") {
+    const TriangleMesh form = mannequin(), seat = chair();
+    for (const TriangleMesh* m : {&form, &seat}) {
+        CHECK(m->closed());
+        CHECK(m->triangles().size() > 2000);
+        CHECK(m->triangles().size() <= 50000);
+        CHECK(m->lo().y == Approx(0.0).margin(2e-3));
+    }
+    CHECK(form.winding_number({0.0, 1.25, 0.0}) == Approx(1.0));   // the chest
+    CHECK(form.winding_number({0.22, 1.2, 0.0}) == Approx(1.0));   // an arm
+    CHECK(form.winding_number({0.0, 0.5, 0.0}) == Approx(1.0));    // the pole
+    CHECK(form.winding_number({0.1, 0.5, 0.0}) == Approx(0.0).margin(1e-9));  // beside the pole
+    CHECK(form.hi().y == Approx(1.61).margin(0.01));
+    CHECK(seat.winding_number({0.0, 0.45, 0.0}) == Approx(1.0));   // the seat
+    CHECK(seat.winding_number({0.19, 0.2, 0.19}) == Approx(1.0));  // a leg
+    CHECK(seat.winding_number({0.0, 0.2, 0.0}) == Approx(0.0).margin(1e-9));  // under the seat
+    // The bundled files are these meshes (clothsim-make-meshes wrote them).
+    CHECK(read_mesh_file(mesh_directory() / "mannequin.obj")->triangles().size() == form.triangles().size());
+    CHECK(read_mesh_file(mesh_directory() / "chair.obj")->triangles().size() == seat.triangles().size());
 }

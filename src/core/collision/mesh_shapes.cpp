@@ -2,12 +2,15 @@
 
 #include "clothsim/overloaded.hpp"
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 #include <numbers>
 #include <utility>
 
@@ -135,6 +138,123 @@ TriangleMesh round_table() {
     }
     flat(r - rim, 0.0, middle + rim);
     return lathe(p, 128);  // the top's edge within 0.15 mm of its circle
+}
+
+TriangleMesh isosurface(const std::function<double(glm::dvec3)>& field, glm::dvec3 lo, glm::dvec3 hi, double cell) {
+    const glm::ivec3 n = glm::max(glm::ivec3(glm::ceil((hi - lo) / cell)), glm::ivec3(1)) + 1;  // grid points per axis
+    auto index = [&](int x, int y, int z) { return (static_cast<std::uint64_t>(z) * n.y + y) * n.x + x; };
+    auto point = [&](std::uint64_t g) {
+        const auto x = static_cast<int>(g % n.x), y = static_cast<int>(g / n.x % n.y), z = static_cast<int>(g / n.x / n.y);
+        return lo + glm::dvec3(x, y, z) * cell;
+    };
+    std::vector<double> value(static_cast<std::size_t>(n.x) * n.y * n.z);
+    for (std::uint64_t g = 0; g < value.size(); ++g) {
+        const double f = field(point(g));
+        value[g] = std::abs(f) < 1e-12 ? 1e-12 : f;  // no grid point on the surface: every crossing is an edge's
+    }
+    std::vector<glm::dvec3> v;
+    std::vector<TriangleMesh::Triangle> f;
+    std::unordered_map<std::uint64_t, std::uint32_t> on_edge;  // grid edge (a, b), a < b -> its vertex
+    auto vertex = [&](std::uint64_t a, std::uint64_t b) {
+        if (a > b) std::swap(a, b);
+        const auto [at, made] = on_edge.try_emplace(a * value.size() + b, static_cast<std::uint32_t>(v.size()));
+        if (made) {
+            const double t = std::clamp(value[a] / (value[a] - value[b]), 0.02, 0.98);
+            v.push_back(point(a) + t * (point(b) - point(a)));
+        }
+        return at->second;
+    };
+    // A triangle on edges (in, out) of a tetrahedron, turned to face from its inside corners to its outside ones.
+    auto emit = [&](std::array<std::uint32_t, 3> t, glm::dvec3 inside, glm::dvec3 outside) {
+        if (glm::dot(glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]), outside - inside) < 0.0) std::swap(t[1], t[2]);
+        f.push_back(t);
+    };
+    // Kuhn's six tetrahedra of a cube: corners 0 and 7 (bits x = 1, y = 2, z = 4) and a path between them.
+    constexpr int kAxes[6][2] = {{1, 2}, {1, 4}, {2, 1}, {2, 4}, {4, 1}, {4, 2}};
+    for (int z = 0; z + 1 < n.z; ++z) {
+        for (int y = 0; y + 1 < n.y; ++y) {
+            for (int x = 0; x + 1 < n.x; ++x) {
+                auto corner = [&](int bits) { return index(x + (bits & 1), y + (bits >> 1 & 1), z + (bits >> 2 & 1)); };
+                for (const auto& axes : kAxes) {
+                    const std::array<std::uint64_t, 4> g = {corner(0), corner(axes[0]), corner(axes[0] | axes[1]), corner(7)};
+                    std::array<std::uint64_t, 4> in{}, out{};
+                    int ins = 0, outs = 0;
+                    for (std::uint64_t c : g) (value[c] < 0.0 ? in[ins++] : out[outs++]) = c;
+                    if (ins == 0 || outs == 0) continue;
+                    glm::dvec3 inside(0.0), outside(0.0);
+                    for (int k = 0; k < ins; ++k) inside += point(in[k]) / double(ins);
+                    for (int k = 0; k < outs; ++k) outside += point(out[k]) / double(outs);
+                    if (ins == 1 || outs == 1) {  // one corner apart: a triangle around it
+                        const std::uint64_t lone = ins == 1 ? in[0] : out[0];
+                        const auto& rest = ins == 1 ? out : in;
+                        emit({vertex(lone, rest[0]), vertex(lone, rest[1]), vertex(lone, rest[2])}, inside, outside);
+                    } else {  // two and two: a quad on the four edges between them, as two triangles
+                        const std::uint32_t a = vertex(in[0], out[0]), b = vertex(in[0], out[1]);
+                        const std::uint32_t c = vertex(in[1], out[1]), d = vertex(in[1], out[0]);
+                        emit({a, b, c}, inside, outside);
+                        emit({a, c, d}, inside, outside);
+                    }
+                }
+            }
+        }
+    }
+    return TriangleMesh(std::move(v), std::move(f));
+}
+
+namespace {
+
+// Signed distances (negative inside) of the mannequin's and the chair's parts (Quilez, "distance functions").
+double ellipsoid(glm::dvec3 p, glm::dvec3 centre, glm::dvec3 radii) {  // a bound, exact on the surface
+    const double k0 = glm::length((p - centre) / radii), k1 = glm::length((p - centre) / (radii * radii));
+    return k1 > 0.0 ? k0 * (k0 - 1.0) / k1 : -std::min({radii.x, radii.y, radii.z});
+}
+double capsule(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, double radius) {
+    const glm::dvec3 pa = p - a, ba = b - a;
+    const double h = std::clamp(glm::dot(pa, ba) / glm::dot(ba, ba), 0.0, 1.0);
+    return glm::length(pa - ba * h) - radius;
+}
+double rounded_box(glm::dvec3 p, glm::dvec3 centre, glm::dvec3 half, double rounding) {
+    const glm::dvec3 q = glm::abs(p - centre) - (half - rounding);
+    return glm::length(glm::max(q, 0.0)) + std::min(std::max({q.x, q.y, q.z}), 0.0) - rounding;
+}
+// The polynomial smooth minimum: a union whose seams are rounded over about k.
+double blend(double a, double b, double k) {
+    const double h = std::max(k - std::abs(a - b), 0.0) / k;
+    return std::min(a, b) - h * h * k * 0.25;
+}
+
+}  // namespace
+
+TriangleMesh mannequin() {
+    const auto field = [](glm::dvec3 p) {
+        double torso = ellipsoid(p, {0.0, 0.98, 0.0}, {0.17, 0.13, 0.12});                // hips
+        torso = blend(torso, ellipsoid(p, {0.0, 1.13, 0.0}, {0.13, 0.12, 0.095}), 0.06);   // waist
+        torso = blend(torso, ellipsoid(p, {0.0, 1.30, 0.01}, {0.16, 0.13, 0.115}), 0.06);  // chest
+        torso = blend(torso, capsule(p, {-0.15, 1.42, 0.0}, {0.15, 1.42, 0.0}, 0.065), 0.05);  // shoulders
+        torso = blend(torso, capsule(p, {0.0, 1.42, 0.0}, {0.0, 1.56, 0.0}, 0.05), 0.03);  // neck
+        for (const double side : {-1.0, 1.0}) {  // arms hanging at the sides
+            torso = blend(torso, capsule(p, {side * 0.2, 1.41, 0.0}, {side * 0.235, 1.02, 0.02}, 0.045), 0.03);
+        }
+        const double stand = blend(capsule(p, {0.0, 0.03, 0.0}, {0.0, 0.9, 0.0}, 0.018),
+                                   ellipsoid(p, {0.0, 0.02, 0.0}, {0.2, 0.02, 0.2}), 0.02);
+        return blend(torso, stand, 0.02);
+    };
+    return isosurface(field, {-0.34, -0.02, -0.24}, {0.34, 1.64, 0.24}, 0.016);
+}
+
+TriangleMesh chair() {
+    const auto field = [](glm::dvec3 p) {
+        const double r = 0.015;
+        double d = rounded_box(p, {0.0, 0.45, 0.0}, {0.22, 0.02, 0.22}, r);                    // seat
+        d = std::min(d, rounded_box(p, {0.0, 0.72, -0.2}, {0.22, 0.25, 0.02}, r));             // backrest
+        for (const double x : {-0.19, 0.19}) {
+            for (const double z : {-0.19, 0.19}) {
+                d = std::min(d, rounded_box(p, {x, 0.22, z}, {0.02, 0.22, 0.02}, 0.01));       // legs
+            }
+        }
+        return d;
+    };
+    return isosurface(field, {-0.25, -0.02, -0.25}, {0.25, 1.0, 0.25}, 0.015);
 }
 
 std::optional<TriangleMesh> collider_surface(const Collider& collider) {

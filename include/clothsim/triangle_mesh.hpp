@@ -17,6 +17,7 @@
 #pragma once
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <array>
 #include <cstddef>
@@ -107,6 +108,9 @@ private:
     std::vector<glm::dvec3> vertices_;
     std::vector<Triangle> triangles_;
     std::vector<glm::dvec3> face_normals_, vertex_normals_;
+    // Each triangle's centroid and the distance from it to its farthest corner: |p - centre| - radius bounds
+    // the distance from p to the triangle from below (closest_of's second cheap rejection).
+    std::vector<glm::dvec4> spheres_;
     std::vector<std::array<glm::dvec3, 3>> edge_normals_;  // per triangle, edge k = (v_k, v_k+1): unit pseudonormal
     std::vector<std::uint32_t> order_;                     // triangle indices, in leaf order
     std::vector<Node> nodes_;                              // depth first; nodes_[0] is the root

@@ -125,6 +125,7 @@ TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangl
     // (Baerentzen & Aanaes 2005).
     const std::size_t n = triangles_.size();
     face_normals_.resize(n);
+    spheres_.resize(n);
     vertex_normals_.assign(vertices_.size(), glm::dvec3(0.0));
     for (std::size_t t = 0; t < n; ++t) {
         const Triangle& tri = triangles_[t];
@@ -133,6 +134,8 @@ TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangl
         const double length = glm::length(cross);
         const glm::dvec3 normal = length > 0.0 ? cross / length : glm::dvec3(0.0);
         face_normals_[t] = normal;
+        const glm::dvec3 centre = (a + b + c) / 3.0;
+        spheres_[t] = glm::dvec4(centre, std::max({glm::length(a - centre), glm::length(b - centre), glm::length(c - centre)}));
         for (int k = 0; k < 3; ++k) {
             const glm::dvec3 p = vertices_[tri[k]];
             const glm::dvec3 e1 = vertices_[tri[(k + 1) % 3]] - p, e2 = vertices_[tri[(k + 2) % 3]] - p;
@@ -249,6 +252,14 @@ std::uint32_t TriangleMesh::build(std::uint32_t first, std::uint32_t count, cons
     // The distance to the triangle's plane bounds the distance to the triangle from below.
     const double plane = glm::dot(p - a, face_normals_[t]);
     if (found ? plane * plane >= best2 : plane * plane > best2) return false;
+    // So does the distance to its bounding sphere: a triangle in the list beside the particle, not under it
+    // (most of a contact grid cell's), is passed over for a dot product instead of the closest point. Widened
+    // by a relative 1e-9, far beyond the rounding of the sphere, so no triangle that could be the nearest is
+    // passed over. (Tested first, before the plane, it took a square root for every listing: 1.2x slower.)
+    const glm::dvec4 sphere = spheres_[t];
+    const glm::dvec3 to_centre = p - glm::dvec3(sphere);
+    const double reach = std::sqrt(best2) + sphere.w;
+    if (glm::dot(to_centre, to_centre) > reach * reach * (1.0 + 1e-9)) return false;
     const Closest c = closest_on_triangle(p, a, vertices_[tri[1]], vertices_[tri[2]]);
     const glm::dvec3 d = p - c.point;
     const double d2 = glm::dot(d, d);

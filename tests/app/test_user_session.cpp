@@ -219,8 +219,8 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
         REQUIRE(opened.width == kWidth);
         CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
     };
-    SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its first item)") {
-        open_curtain("session_open_combo", "click 110 59\nclick 40 84\n");
+    SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its second item)") {
+        open_curtain("session_open_combo", "click 110 59\nclick 40 101\n");
     }
     SECTION("typed into the built-in file browser's name field after Open file...") {
         open_curtain("session_open_file", "click 50 82\nsettle\ntype '" + scene_path("curtain") + "'\nkey Return\n");
@@ -362,7 +362,7 @@ TEST_CASE("user session: labels follow the scene, and two F12 presses in a secon
     const TempDir dir("session_labels");
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
                                          "echo \"title before: $(xdotool getwindowname $wid)\"\n"
-                                         "click 110 59\nclick 40 84\nat 900 400\nsettle\n"
+                                         "click 110 59\nclick 40 101\nat 900 400\nsettle\n"  // curtain, after chair-drape
                                          "echo \"title after: $(xdotool getwindowname $wid)\"\n"
                                          // Each press waits for its file (up to 20 s under load); in most runs both land in one second.
                                          "xdotool keydown F12; sleep 0.1; xdotool keyup F12\n"
@@ -691,12 +691,13 @@ TEST_CASE("user session: each pin of hanging and curtain dragged 300 px in half 
 TEST_CASE("user session: the Colliders section adds a box, removes the ground and grows the sphere, live, and Save writes the list") {
     const TempDir dir("session_collider_list");
     // drape-sphere, paused: Springs and Integration folded so the Colliders section opens in view. Its list
-    // holds "0: sphere" (radius at y = 375) and "1: plane" (its remove button at x = 117, y = 396), then the
-    // add-collider combo, whose second item is "box".
+    // holds "0: sphere" (enabled, friction, velocity, spin, center, radius at y = 421) and "1: plane" (its
+    // remove button at x = 117, y = 441), then the add-collider combo (y = 576), whose second item is "box"
+    // (y = 617).
     const RunResult r = run_user_session(
         dir, {"--scene", "drape-sphere", "--paused"},
         std::string("click 60 197\nclick 60 243\nclick 60 266\nshot colliders.png\n") +
-            "click 120 484\nclick 25 525\nclick 117 396\ndrag 120 375 160 375\nshot edited.png\n" +
+            "click 120 576\nclick 25 617\nclick 117 441\ndrag 120 421 160 421\nshot edited.png\n" +
             "echo \"title edited: $(xdotool getwindowname $wid)\"\nclick " + kSave +
             "\nwait_for drape-sphere-edited.toml\nquit\n",
         zenity_saving_as_proposed(dir));

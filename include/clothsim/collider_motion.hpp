@@ -10,7 +10,8 @@
 // Which turns change the geometry: a mesh turns; a sphere and a vertical cylinder about y are unchanged by
 // theirs, which only move their surface (a spinning ball drags the cloth by friction); a box stays axis-aligned
 // and a plane horizontal, so a spin that would tilt them is refused (spin_problem). A plane's velocity along
-// x and z moves its surface only (a conveyor belt).
+// x and z moves its surface only (a conveyor belt). A drag's move (MassSpring::move_collider) also sets the
+// motion's `stop`: the time it stops where it has got to.
 //
 // The contact (colliders.hpp) uses the motion relative to the surface: a particle's displacement over the
 // substep less the displacement of the collider's material point where it is (SurfaceMotion), for the

@@ -269,8 +269,10 @@ TEST_CASE("live tuning: mannequin-drape takes wind, damping and stretch while it
 TEST_CASE("live tuning: chair-drape takes wind, damping and stretch while it runs", "[every-scene]") {
     tune_live("chair-drape", {});
 }
-TEST_CASE("live tuning: moving-ball takes wind, damping and stretch while the ball rolls", "[every-scene]") {
-    tune_live("moving-ball", {});
+TEST_CASE("live tuning: moving-ball takes wind and damping while the ball rolls (the ball pushes its cloth together: "
+          "in compression, its mean strain shows no stretch)",
+          "[every-scene]") {
+    tune_live("moving-ball", {.stretch_shows = false});
 }
 TEST_CASE("live tuning: pile takes damping and stretch while it runs (wind along a flat cloth exerts no force)",
           "[every-scene]") {

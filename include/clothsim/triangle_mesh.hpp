@@ -20,6 +20,7 @@
 #include <glm/vec4.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -39,12 +40,41 @@ inline constexpr double kMaxMeshCoordinate = 1e6;
 // triangles[start[c] .. start[c + 1]) with c = i + size.x (j + size.y k), in increasing index. A triangle is
 // listed in every cell that its box grown by `band` meets, so every triangle within `band` of a point in a
 // cell is in that cell's list.
+//
+// A cell that lists no triangle lies wholly farther than `band` from the surface, so wholly inside or wholly
+// outside; for a closed mesh `inside` says which (1: inside the solid), found once per region of such cells
+// that touch face to face (a flood fill, one signed nearest-point query at a cell's centre per region). The
+// collider then sees a particle deep inside, where the nearest-point test within the band sees nothing.
 struct ContactGrid {
+    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     double band = 0.0, cell = 0.0;
     glm::dvec3 origin{0.0};
     std::array<int, 3> size{0, 0, 0};
     std::vector<std::uint32_t> start, triangles;
+    std::vector<std::uint8_t> inside;  // per cell; empty for an open mesh
+
+    // The index of the cell holding p, or kNone outside the grid (or for a NaN).
+    std::size_t cell_of(glm::dvec3 p) const {
+        std::size_t index = 0, stride = 1;
+        for (int a = 0; a < 3; ++a) {
+            const double at = std::floor((p[a] - origin[a]) / cell);
+            if (!(at >= 0.0 && at < size[a])) return kNone;
+            index += static_cast<std::size_t>(at) * stride;
+            stride *= static_cast<std::size_t>(size[a]);
+        }
+        return index;
+    }
+    // Whether p lies inside a closed mesh and farther than `band` from its surface (by its cell: exact).
+    bool deep_inside(glm::dvec3 p) const {
+        if (inside.empty()) return false;
+        const std::size_t c = cell_of(p);
+        return c != kNone && inside[c] != 0;
+    }
 };
+
+// The point of triangle abc nearest p (Ericson, "Real-Time Collision Detection", 2005, 5.1.5): what every
+// nearest-point query of a mesh computes for each triangle it cannot pass over.
+glm::dvec3 closest_point_on_triangle(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c);
 
 class TriangleMesh {
 public:
@@ -104,6 +134,8 @@ private:
     // The node of order_[first, first + count), split at the median of the triangles' centres.
     std::uint32_t build(std::uint32_t first, std::uint32_t count, const std::vector<glm::dvec3>& centres);
     bool closest_of(glm::dvec3 p, std::uint32_t t, double& best2, bool found, Nearest& out) const;
+    // Fills grid.inside (ContactGrid).
+    void classify_empty_cells(ContactGrid& grid) const;
 
     std::vector<glm::dvec3> vertices_;
     std::vector<Triangle> triangles_;

@@ -635,6 +635,107 @@ TEST_CASE("colliders the tablecloth settles on the round table mesh: no particle
     CHECK(on_top > 100);  // it lies on the table, not on the floor beside it
 }
 
+namespace {
+
+// How many particles lie inside the closed mesh `collider` (winding number), how many of those deeper than
+// `thickness`, and the smallest signed distance to it of those outside.
+struct MeshClearance {
+    int inside = 0, deep = 0;
+    float nearest = INFINITY;
+};
+MeshClearance mesh_clearance(const MassSpring& sim, const Collider& collider, float thickness) {
+    const MeshCollider& m = std::get<MeshCollider>(collider.shape);
+    const PlacedMesh at = placed(m);
+    MeshClearance c;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const float distance = signed_distance(m, sim.position(i));
+        if (m.mesh->winding_number(at.to_mesh(glm::dvec3(sim.position(i)))) > 0.5) {
+            ++c.inside;
+            c.deep += distance < -thickness * (1.0f + 1e-4f);
+        } else {
+            c.nearest = std::min(c.nearest, distance);
+        }
+    }
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("colliders a mesh that jumps onto the cloth (a typed position, a dropped mesh) pushes out every particle "
+          "it swallowed", "[colliders]") {
+    // The tablecloth settled on its table (at a 6 cm spacing), then the table typed 3 cm higher: its top, 6 cm
+    // thick, swallows the cloth lying on it 2.2 cm deep, beyond the 8 mm shell the mesh's contact sees. At once
+    // no particle is deeper inside than the shell (those in it are the contact's), and a step later none is
+    // inside or nearer than half the thickness.
+    Scene scene = load_scene("tablecloth");
+    scene.cloth.rows = scene.cloth.cols = 24;
+    MassSpring sim = build_simulation(scene);
+    sim.run_steps(60);
+    const float thickness = scene.settings.colliders.thickness;
+    SimulationSettings raised = sim.settings();
+    std::get<MeshCollider>(raised.colliders.shapes[0].shape).position.y += 0.03f;
+    CHECK(mesh_clearance(sim, raised.colliders.shapes[0], thickness).deep > 100);  // what the jump swallows
+    sim.apply(raised);
+    CHECK(mesh_clearance(sim, sim.colliders()[0], thickness).deep == 0);
+    sim.run_steps(1);
+    const MeshClearance stepped = mesh_clearance(sim, sim.colliders()[0], thickness);
+    CHECK(stepped.inside == 0);
+    CHECK(stepped.nearest > 0.5f * thickness);
+    sim.run_steps(30);
+    REQUIRE(sim.all_finite());
+    const MeshClearance settled = mesh_clearance(sim, sim.colliders()[0], thickness);
+    CHECK(settled.inside == 0);
+    CHECK(settled.nearest > 0.5f * thickness);
+
+    // A box mesh dropped onto the cloth: a new collider, 20 cm across, half sunk into the table top.
+    SimulationSettings dropped = sim.settings();
+    MeshCollider box;
+    box.mesh = std::make_shared<const TriangleMesh>(box_mesh({0.2, 0.2, 0.2}));
+    box.position = {0.1f, 0.79f, -0.05f};
+    dropped.colliders.shapes.push_back(frictionless(box));
+    CHECK(mesh_clearance(sim, dropped.colliders.shapes.back(), thickness).deep > 10);
+    sim.apply(dropped);
+    CHECK(mesh_clearance(sim, sim.colliders().back(), thickness).deep == 0);
+    sim.run_steps(10);
+    REQUIRE(sim.all_finite());
+    for (const Collider& c : sim.colliders()) {
+        if (!std::holds_alternative<MeshCollider>(c.shape)) continue;
+        const MeshClearance around = mesh_clearance(sim, c, thickness);
+        CHECK(around.inside == 0);
+        CHECK(around.nearest > 0.5f * thickness);
+    }
+}
+
+TEST_CASE("colliders a cloth built inside a closed mesh starts outside it; an open mesh moves nothing", "[colliders]") {
+    Scene scene = per_spring_scene("hanging");
+    scene.cloth.rows = scene.cloth.cols = 10;
+    scene.cloth.origin = {-0.2f, 0.5f, -0.2f};
+    scene.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    scene.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    scene.cloth.size = {0.4f, 0.4f};
+    scene.pins = PinSpec{PinPreset::None, {}, 0.0f, ClipKind::Rigid};
+    MeshCollider box;
+    box.mesh = std::make_shared<const TriangleMesh>(box_mesh({0.8, 0.6, 0.8}));  // y from 0 to 0.6
+    box.position = {0.0f, 0.3f, 0.0f};
+    scene.settings.colliders.shapes = {frictionless(box)};
+    const MassSpring sim = build_simulation(scene);
+    const MeshClearance c = mesh_clearance(sim, sim.colliders()[0], scene.settings.colliders.thickness);
+    CHECK(c.inside == 0);
+    CHECK(c.nearest > 0.5f * scene.settings.colliders.thickness);
+    // Out through the top: the cloth lies 10 cm under it and 20 cm or more from every side.
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        CHECK(sim.position(i).y == Approx(0.6f + scene.settings.colliders.thickness).margin(1e-5));
+    }
+
+    // A sheet has no inside: nothing moves.
+    MeshCollider sheet;
+    sheet.mesh = std::make_shared<const TriangleMesh>(TriangleMesh({{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}}, {{0, 2, 1}, {0, 3, 2}}));
+    State state = sim.state();
+    const State kept = state;
+    CHECK(push_out_of_mesh(state, frictionless(sheet), 0.005f) == 0);
+    CHECK(state.position.y == kept.position.y);
+}
+
 TEST_CASE("colliders the sphere's four-lane block test moves every particle as the particle-by-particle test, on "
           "every kernel", "[colliders]") {
     ColliderSettings colliders;

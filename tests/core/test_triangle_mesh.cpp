@@ -226,6 +226,37 @@ TEST_CASE("triangle mesh contact grid answers as the tree does, and stays bounde
     CHECK(on->distance == Approx(0.5e-6));
 }
 
+TEST_CASE("triangle mesh contact grid knows which of its cells that list no triangle lie inside a closed mesh",
+          "[triangle_mesh]") {
+    // The icosphere's grid at a 1 cm band has cells that list no triangle inside the ball and around it: a point
+    // in one is deep inside exactly when its winding number says inside.
+    const TriangleMesh ball = icosphere(0.3, 4);
+    const auto grid = ball.contact_grid(0.01);
+    REQUIRE(grid->inside.size() == grid->start.size() - 1);
+    CHECK(grid->deep_inside({0.0, 0.0, 0.0}));
+    CHECK_FALSE(grid->deep_inside({0.0, 0.305, 0.0}));  // near the surface: its cell lists triangles
+    CHECK_FALSE(grid->deep_inside({0.0, 0.5, 0.0}));    // outside the grid
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> coordinate(-0.3, 0.3);
+    int deep = 0, empty_outside = 0;
+    for (int k = 0; k < 4000; ++k) {
+        const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+        const std::size_t c = grid->cell_of(p);
+        REQUIRE(c != ContactGrid::kNone);
+        if (grid->start[c + 1] != grid->start[c]) continue;
+        const bool inside = ball.winding_number(p) > 0.5;
+        INFO("point " << p.x << ", " << p.y << ", " << p.z);
+        CHECK(grid->deep_inside(p) == inside);
+        deep += inside;
+        empty_outside += !inside;
+    }
+    CHECK(deep > 500);
+    CHECK(empty_outside > 100);
+    // An open mesh has no inside.
+    const TriangleMesh sheet({{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}}, {{0, 2, 1}, {0, 3, 2}});
+    CHECK(sheet.contact_grid(0.01)->inside.empty());
+}
+
 TEST_CASE("triangle mesh isosurface meshes a signed distance as a closed surface on its zero set", "[triangle_mesh]") {
     // A sphere of radius 0.3 sampled every 2 cm: every vertex on the sphere (a signed distance interpolates
     // exactly along a grid edge up to its curvature), closed, winding number 1 inside and 0 outside.

@@ -249,6 +249,41 @@ void collide(State& state, const Collider& collider, float thickness, std::size_
     }, collider.shape);
 }
 
+std::size_t push_out_of_mesh(State& state, const Collider& collider, float thickness) {
+    const auto* shape = std::get_if<MeshCollider>(&collider.shape);
+    if (!collider.enabled || !shape || !shape->mesh || !shape->mesh->closed() || !(shape->scale > 0.0f) ||
+        !(thickness > 0.0f)) {
+        return 0;
+    }
+    const PlacedMesh at = placed(*shape, thickness);
+    const TriangleMesh& mesh = *at.mesh;
+    const ContactGrid& grid = *at.grid;
+    const double shell = static_cast<double>(thickness) / at.scale;
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        if (state.pinned[i]) continue;
+        const glm::dvec3 q = at.to_mesh(state.position.get(i));
+        if (q.x < mesh.lo().x || q.x > mesh.hi().x || q.y < mesh.lo().y || q.y > mesh.hi().y || q.z < mesh.lo().z ||
+            q.z > mesh.hi().z) {
+            continue;  // outside the mesh's box (a NaN too)
+        }
+        // Within the shell: the contact's; in a cell that lists no triangle: the cell says; else the tree.
+        if (mesh.nearest(q, shell, grid)) continue;
+        const std::size_t cell = grid.cell_of(q);
+        if (cell != ContactGrid::kNone && grid.start[cell + 1] == grid.start[cell] && !grid.inside[cell]) continue;
+        const auto near = mesh.nearest(q, INFINITY);
+        if (!near || !near->inside) continue;
+        // Out along the way to the nearest point, and the thickness past it.
+        const glm::dvec3 out = near->distance > 0.0 ? (near->point - q) / near->distance : near->normal;
+        const glm::dvec3 normal = at.rotation * out;
+        state.position.set(i, at.to_world(near->point + shell * out));
+        const glm::dvec3 motion = state.motion.get(i);
+        state.motion.set(i, motion - std::min(glm::dot(motion, normal), 0.0) * normal);
+        ++moved;
+    }
+    return moved;
+}
+
 namespace {
 
 // Whether a solid shape (not a half-space) that is enabled may touch a particle in `box`.

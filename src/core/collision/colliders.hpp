@@ -40,6 +40,14 @@ void collide(State& state, const Collider& collider, float thickness, std::size_
 void collide_all(State& state, const ColliderSettings& colliders, std::size_t begin = 0,
                  std::size_t end = kAllParticles);
 
+// A collider that jumps onto the cloth (a typed position, a dropped mesh, a cloth built inside it) may swallow
+// particles deeper than its thickness shell. The analytic solids push those out from any depth at the next
+// substep; a mesh's contact sees only its shell (shapes/mesh.hpp), so this moves each free particle deeper
+// inside a closed mesh than the thickness out by the nearest way, to the thickness outside the surface,
+// keeping its motion less any part into the surface (an inelastic contact). Open meshes have no inside and
+// other shapes need none: nothing is moved. Returns how many particles moved.
+std::size_t push_out_of_mesh(State& state, const Collider& collider, float thickness);
+
 // The particles as blocks (broad_phase.hpp: block_starts), each block's box and the whole cloth's box.
 //
 // The carried box holds every particle, and the start of its path over the substep (x - motion, where the

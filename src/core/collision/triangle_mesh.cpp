@@ -97,6 +97,10 @@ bool segment_meets_box(glm::dvec3 p0, glm::dvec3 d, double t_hi, glm::dvec3 lo, 
 
 }  // namespace
 
+glm::dvec3 closest_point_on_triangle(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    return closest_on_triangle(p, a, b, c).point;
+}
+
 TriangleMesh::TriangleMesh(std::vector<glm::dvec3> vertices, std::vector<Triangle> triangles)
     : vertices_(std::move(vertices)), triangles_(std::move(triangles)) {
     if (triangles_.empty()) throw std::invalid_argument("the mesh has no triangles");
@@ -305,14 +309,8 @@ std::optional<TriangleMesh::Nearest> TriangleMesh::nearest(glm::dvec3 p, double 
     Nearest out{};
     bool found = false;
     double best2 = radius * radius;
-    std::array<int, 3> cell;
-    for (int a = 0; a < 3; ++a) {
-        const double at = std::floor((p[a] - grid.origin[a]) / grid.cell);
-        if (!(at >= 0.0 && at < grid.size[a])) return std::nullopt;  // outside the grid: nothing within the band
-        cell[a] = static_cast<int>(at);
-    }
-    const std::size_t c = static_cast<std::size_t>(cell[0]) +
-                          static_cast<std::size_t>(grid.size[0]) * (cell[1] + static_cast<std::size_t>(grid.size[1]) * cell[2]);
+    const std::size_t c = grid.cell_of(p);
+    if (c == ContactGrid::kNone) return std::nullopt;  // outside the grid: nothing within the band
     for (std::uint32_t i = grid.start[c]; i < grid.start[c + 1]; ++i) found |= closest_of(p, grid.triangles[i], best2, found, out);
     if (!found) return std::nullopt;
     out.distance = std::sqrt(best2);
@@ -399,10 +397,48 @@ std::shared_ptr<const ContactGrid> TriangleMesh::contact_grid(double band) const
             if (near_centre(t, c)) grid->triangles[next[c]++] = t;
         });
     }
+    if (closed_) classify_empty_cells(*grid);
     std::lock_guard lock(grids_->mutex);
     grids_->recent.push_back(grid);
     if (grids_->recent.size() > 4) grids_->recent.erase(grids_->recent.begin());
     return grid;
+}
+
+void TriangleMesh::classify_empty_cells(ContactGrid& grid) const {
+    const std::size_t cells = grid.start.size() - 1;
+    const std::size_t nx = static_cast<std::size_t>(grid.size[0]), ny = static_cast<std::size_t>(grid.size[1]);
+    const std::size_t nz = static_cast<std::size_t>(grid.size[2]);
+    // 0: not yet reached (or a cell that lists triangles); 1: outside; 2: inside.
+    std::vector<std::uint8_t> side(cells, 0);
+    std::vector<std::size_t> stack;
+    for (std::size_t seed = 0; seed < cells; ++seed) {
+        if (side[seed] != 0 || grid.start[seed + 1] != grid.start[seed]) continue;
+        const std::size_t i = seed % nx, j = (seed / nx) % ny, k = seed / (nx * ny);
+        const glm::dvec3 centre = grid.origin + grid.cell * (glm::dvec3(double(i), double(j), double(k)) + 0.5);
+        const auto near = nearest(centre, INFINITY);
+        const std::uint8_t region = near && near->inside ? 2 : 1;
+        side[seed] = region;
+        stack.push_back(seed);
+        while (!stack.empty()) {
+            const std::size_t c = stack.back();
+            stack.pop_back();
+            const std::size_t ci = c % nx, cj = (c / nx) % ny, ck = c / (nx * ny);
+            auto reach = [&](bool exists, std::size_t n) {
+                if (exists && side[n] == 0 && grid.start[n + 1] == grid.start[n]) {
+                    side[n] = region;
+                    stack.push_back(n);
+                }
+            };
+            reach(ci > 0, c - 1);
+            reach(ci + 1 < nx, c + 1);
+            reach(cj > 0, c - nx);
+            reach(cj + 1 < ny, c + nx);
+            reach(ck > 0, c - nx * ny);
+            reach(ck + 1 < nz, c + nx * ny);
+        }
+    }
+    grid.inside.resize(cells);
+    for (std::size_t c = 0; c < cells; ++c) grid.inside[c] = side[c] == 2;
 }
 
 std::optional<TriangleMesh::Crossing> TriangleMesh::first_crossing(glm::dvec3 p0, glm::dvec3 p1, bool front_only) const {

@@ -63,6 +63,7 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
                                      : std::vector<glm::dvec3>(initial_velocity.begin(), initial_velocity.end()),
             substep_length());
+    push_out_of_jumped_meshes({});  // a cloth built inside a mesh starts outside it
     stamp_ = next_stamp();
     setup_stamp_ = next_stamp();
     topology_stamp_ = next_stamp();
@@ -146,10 +147,14 @@ void MassSpring::apply(const SimulationSettings& settings) {
             if (hold.share_u > 0.0f || hold.share_v > 0.0f) hold.stiffness = hold.stiffness_for(settings.springs.structural);
         }
     }
+    const bool colliders_changed = settings.colliders != settings_.colliders;
+    std::vector<Collider> before;
+    if (colliders_changed) before = colliders();
     settings_ = settings;
     if (in_->grab) in_->grab->force_limit = grab_force_limit(in_->grab->particle);  // it follows the springs' k
     replan();
     track_collider_motion();
+    if (colliders_changed) push_out_of_jumped_meshes(before);
     wake();  // a changed setting (a collider moved, wind, a slider) is something driving the cloth
     // Self-collision's list and budget say nothing of what the cloth did while the stage was off or set
     // otherwise: it tests afresh at its next substep.
@@ -169,6 +174,19 @@ void MassSpring::track_collider_motion() {
     in_->posed = settings_.colliders;
     in_->surfaces.assign(shapes.size(), SurfaceMotion{});
     pose_colliders(state_.time, state_.time);
+}
+
+void MassSpring::push_out_of_jumped_meshes(const std::vector<Collider>& before) {
+    const std::vector<Collider>& now = colliders_now().shapes;
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < now.size(); ++i) {
+        if (!std::holds_alternative<MeshCollider>(now[i].shape)) continue;
+        const bool jumped = i >= before.size() || !before[i].enabled || !(before[i].shape == now[i].shape);
+        if (jumped) moved += push_out_of_mesh(state_, now[i], settings_.colliders.thickness);
+    }
+    if (moved == 0) return;
+    stamp_ = next_stamp();
+    in_->blocks.moved_outside_motion();
 }
 
 // The moving colliders posed at t1, and their surfaces' motion over [t0, t1].

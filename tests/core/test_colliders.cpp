@@ -528,6 +528,18 @@ Collider mesh_collider(TriangleMesh mesh, glm::vec3 position, glm::vec3 rotation
     return frictionless(m);
 }
 
+// hanging's per-spring cloth as a level square of n x n particles, `side` metres across, centred over the
+// origin at height y.
+Scene level_square(int n, float side, float y) {
+    Scene scene = per_spring_scene("hanging");
+    scene.cloth.rows = scene.cloth.cols = n;
+    scene.cloth.origin = {-0.5f * side, y, -0.5f * side};
+    scene.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    scene.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    scene.cloth.size = {side, side};
+    return scene;
+}
+
 }  // namespace
 
 TEST_CASE("colliders a mesh pushes a particle as the analytic shape it meshes: an icosphere as the sphere, a turned "
@@ -589,12 +601,7 @@ TEST_CASE("colliders a cloth falling at 5 m/s with one substep per 1/60 s never 
     // cloth falls through in one substep. Every particle stays above the slab's upper face, every step.
     for (float tilt : {0.0f, 30.0f}) {
         INFO("tilt " << tilt);
-        Scene scene = per_spring_scene("hanging");
-        scene.cloth.rows = scene.cloth.cols = 12;
-        scene.cloth.origin = {-0.3f, 0.8f, -0.3f};
-        scene.cloth.u_axis = {1.0f, 0.0f, 0.0f};
-        scene.cloth.v_axis = {0.0f, 0.0f, 1.0f};
-        scene.cloth.size = {0.6f, 0.6f};
+        Scene scene = level_square(12, 0.6f, 0.8f);
         scene.pins = PinSpec{};
         scene.settings.integration.substeps = 1;  // XPBD: stable at any substep (Verlet is not, at 1/60 s)
         scene.settings.integration.integrator = Integrator::Xpbd;
@@ -707,12 +714,7 @@ TEST_CASE("colliders a mesh that jumps onto the cloth (a typed position, a dropp
 }
 
 TEST_CASE("colliders a cloth built inside a closed mesh starts outside it; an open mesh moves nothing", "[colliders]") {
-    Scene scene = per_spring_scene("hanging");
-    scene.cloth.rows = scene.cloth.cols = 10;
-    scene.cloth.origin = {-0.2f, 0.5f, -0.2f};
-    scene.cloth.u_axis = {1.0f, 0.0f, 0.0f};
-    scene.cloth.v_axis = {0.0f, 0.0f, 1.0f};
-    scene.cloth.size = {0.4f, 0.4f};
+    Scene scene = level_square(10, 0.4f, 0.5f);
     scene.pins = PinSpec{PinPreset::None, {}, 0.0f, ClipKind::Rigid};
     MeshCollider box;
     box.mesh = std::make_shared<const TriangleMesh>(box_mesh({0.8, 0.6, 0.8}));  // y from 0 to 0.6

@@ -220,7 +220,8 @@ private:
     void replan();
     void track_collider_motion();
     // Moves the particles that a mesh collider jumping onto the cloth swallowed out of it (colliders.hpp:
-    // push_out_of_mesh): each enabled mesh whose pose differs from `before`'s at the same index, or is new.
+    // push_out_of_mesh): each enabled mesh that is new, or whose pose moved by 1% of the thickness or more from
+    // `before`'s at the same index, or turned, or changed its mesh or scale.
     void push_out_of_jumped_meshes(const std::vector<Collider>& before);
     void pose_colliders(double t0, double t1) const;
     const ColliderSettings& colliders_now() const;

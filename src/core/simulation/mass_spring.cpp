@@ -178,11 +178,20 @@ void MassSpring::track_collider_motion() {
 
 void MassSpring::push_out_of_jumped_meshes(const std::vector<Collider>& before) {
     const std::vector<Collider>& now = colliders_now().shapes;
+    const float thickness = settings_.colliders.thickness;
+    // A drag or a new velocity re-expresses the pose at this time through the fields at time 0 (with_velocity),
+    // which may round it by a float ulp: no jump. A move of 1% of the thickness or more is one.
+    auto jumped = [&](std::size_t i) {
+        const auto* was = i < before.size() && before[i].enabled ? std::get_if<MeshCollider>(&before[i].shape) : nullptr;
+        const MeshCollider& is = std::get<MeshCollider>(now[i].shape);
+        return !was || was->mesh != is.mesh || was->scale != is.scale ||
+               glm::length(was->rotation - is.rotation) > 1e-3f || glm::length(was->position - is.position) >= 0.01f * thickness;
+    };
     std::size_t moved = 0;
     for (std::size_t i = 0; i < now.size(); ++i) {
-        if (!std::holds_alternative<MeshCollider>(now[i].shape)) continue;
-        const bool jumped = i >= before.size() || !before[i].enabled || !(before[i].shape == now[i].shape);
-        if (jumped) moved += push_out_of_mesh(state_, now[i], settings_.colliders.thickness);
+        if (std::holds_alternative<MeshCollider>(now[i].shape) && jumped(i)) {
+            moved += push_out_of_mesh(state_, now[i], thickness);
+        }
     }
     if (moved == 0) return;
     stamp_ = next_stamp();

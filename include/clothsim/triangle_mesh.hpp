@@ -43,8 +43,9 @@ inline constexpr double kMaxMeshCoordinate = 1e6;
 //
 // A cell that lists no triangle lies wholly farther than `band` from the surface, so wholly inside or wholly
 // outside; for a closed mesh `inside` says which (1: inside the solid), found once per region of such cells
-// that touch face to face (a flood fill, one signed nearest-point query at a cell's centre per region). The
-// collider then sees a particle deep inside, where the nearest-point test within the band sees nothing.
+// that touch face to face (a flood fill, one signed nearest-point query at a cell's centre per region). A
+// mesh that jumps onto the cloth finds the particles it swallowed by it (colliders.hpp: push_out_of_mesh),
+// where the nearest-point test within the band sees nothing.
 struct ContactGrid {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     double band = 0.0, cell = 0.0;

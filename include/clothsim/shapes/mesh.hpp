@@ -5,7 +5,8 @@
 // from the angle-weighted pseudonormal, so a closed mesh pushes a particle out the way it came in and an open
 // one (a sheet) holds it on the side it is on. A particle deeper inside a closed mesh than the thickness is
 // not seen by the proximity test: continuous collision keeps particles from getting there (a path that
-// crosses the surface stops where it entered the shell), and a cloth must start outside.
+// crosses the surface stops where it entered the shell), and a mesh that appears or jumps onto the cloth
+// pushes out what it swallowed then (colliders.hpp: push_out_of_mesh).
 // Queries run in the mesh's coordinates: the particle is moved into them (R^T (p - position) / scale) and
 // the answer back. `placed()` computes R once per collision stage instead of per particle.
 #pragma once

@@ -165,6 +165,11 @@ public:
     // std::invalid_argument when `mass` has another length or a present particle's mass is not positive and
     // finite (nothing changes then).
     void set_masses(std::span<const float> mass);
+    // Sets the weight of every spring (its k is the settings' k times its weight) to that of the spring with the
+    // same two particles in `from`, in place (a mesh cloth's fabric changed live: cloth_mesh.hpp, membrane_springs;
+    // a torn cloth has fewer springs than `from`). Throws std::invalid_argument, changing nothing, when a spring has
+    // no match in `from` or would get a weight that is negative or not finite.
+    void set_spring_weights(std::span<const Spring> from);
     // Pins or frees a particle; a newly pinned particle stops where it is.
     void set_pinned(std::size_t i, bool pinned);
     // Moves a pinned particle to `position` (a grab, a moving anchor); it carries no velocity of its own, its

@@ -41,6 +41,11 @@ std::filesystem::path scene_file_directory(std::string_view scene_source);
 struct MeshCollider;
 void load_collider_mesh(MeshCollider& collider, const std::filesystem::path& scene_directory);
 
+// Reads the OBJ file cloth.mesh names (found as a mesh collider's file is) into cloth.mesh_data, refused with
+// the reason when it cannot be a cloth (cloth_mesh.hpp: cloth_mesh_problem); "" clears it. Throws SceneError.
+struct ClothSettings;
+void load_cloth_mesh(ClothSettings& cloth, const std::filesystem::path& scene_directory);
+
 // $CLOTHSIM_MESHES, else share/clothsim/meshes (data_dirs.hpp).
 std::filesystem::path mesh_directory();
 

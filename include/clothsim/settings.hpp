@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -78,6 +79,14 @@ struct ClothSettings {
     glm::vec3 v_axis{0.0f, -1.0f, 0.0f};     // direction of increasing row (normalised when built)
     glm::vec3 velocity{0.0f, 0.0f, 0.0f};    // m/s: initial velocity of every free particle
     ClothShape shape = ClothShape::Rectangle;
+    // A triangle mesh instead of the grid (cloth_mesh.hpp): an OBJ file, found as a mesh collider's, its
+    // vertices scaled by mesh_scale, turned by mesh_rotation (degrees about x, then y, then z) and moved by
+    // origin. rows, cols, size, shape and v_axis then do not apply; u_axis is the warp direction.
+    std::string mesh;                        // "" = the grid
+    glm::vec3 mesh_rotation{0.0f, 0.0f, 0.0f};  // degrees
+    float mesh_scale = 1.0f;                 // mesh units to metres
+    std::shared_ptr<const TriangleMesh> mesh_data;  // read from `mesh` when the scene is loaded
+    bool is_mesh() const { return !mesh.empty(); }
 };
 
 // The stiffness every spring and bend uses, by kind and axis (spring.hpp). A per-spring scene sets them
@@ -115,6 +124,7 @@ struct Pin {
     int row = 0;
     int col = 0;
     float radius = 0.0f;  // m: 0 = this particle only
+    int vertex = -1;      // -1, or the vertex (from 0) instead of row and col: a mesh cloth's, or a grid's row-major
     bool operator==(const Pin&) const = default;
 };
 

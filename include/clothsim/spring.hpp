@@ -3,6 +3,7 @@
 // so that changing it applies live, without rebuilding the element lists.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 namespace clothsim {
@@ -46,6 +47,26 @@ struct Bend {
     std::uint32_t b = 0;
     Axis axis = Axis::U;
     float weight = 1.0f;  // 0.5 on the cloth's edge rows and columns, which carry half a line's width
+};
+
+// A hinge: the bending across an interior edge (v[0], v[1]) of a triangle mesh cloth, between its two
+// triangles (v[0], v[1], v[2]) and (v[0], v[1], v[3]), with Bergou et al. 2006's quadratic energy (the same
+// paper as Bend; Wardetzky, Bergou, Harmon, Zorin & Grinspun 2007, "Discrete quadratic curvature energies"):
+// E = 0.5 k |sum_i c_i x_i|^2 with the rest shape's cotangent weights
+//   c = (cot b_0 + cot b_1, cot a_0 + cot a_1, -(cot a_0 + cot b_0), -(cot a_1 + cot b_1)),
+// a_t and b_t the angles of triangle t at v[0] and v[1]. The weights sum to 0 and sum_i c_i x_i vanishes for
+// the flat rest shape, so the energy is 0 there and for any rigid motion of it; for a dihedral angle theta,
+// |sum_i c_i x_i| = 2 |e| sin(theta / 2). k = B / (A_0 + A_1) gives a cylinder of curvature kappa the plate
+// energy 0.5 B kappa^2 per area (docs/MESH_CLOTH.md measures it; Bergou et al.'s 3 / (A_0 + A_1) with this
+// stencil stores three times that), B the flexural rigidity across the edge: with B_u and B_v bending along u
+// and along v, B = B_u w_u + B_v w_v, w_u = sin^2 and w_v = cos^2 of the rest edge's angle to u_axis (an edge
+// along u bends along v). So k = bending.x weight_u + bending.y weight_v, the weights (1/m^2) holding
+// 1 / (A_0 + A_1) times those shares.
+struct Hinge {
+    std::array<std::uint32_t, 4> v{};
+    std::array<float, 4> c{};
+    float weight_u = 0.0f;
+    float weight_v = 0.0f;
 };
 
 }  // namespace clothsim

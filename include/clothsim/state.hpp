@@ -9,6 +9,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include <algorithm>
@@ -68,11 +69,15 @@ struct SoftClipSpring {
     }
 };
 
+// A grid cloth has rows x cols particles, row-major. A mesh cloth (cloth.mesh) is stored as one row of its
+// vertices (rows = 1): what reads rows and columns sees a single row, and no grid kernel takes it (their
+// layouts need the grid's springs).
 struct Topology {
     int rows = 0;
     int cols = 0;
     std::vector<Spring> springs;
     std::vector<Bend> bends;  // the material form's bending (kind Bending); the per-spring form has none
+    std::vector<Hinge> hinges;  // a mesh cloth's bending (kind Bending), instead of bends
     std::vector<SoftClipSpring> clip_springs;  // soft clips' particles (pins with clip = "soft")
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
     // The triangles are every grid cell's two, in row-major cell order: (00, 01, 10) and (01, 11, 10) for the
@@ -85,8 +90,14 @@ struct Topology {
     void count_by_kind() {
         spring_count_by_kind = {};
         for (const Spring& s : springs) ++spring_count_by_kind[static_cast<int>(s.kind)];
-        spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += bends.size();
+        spring_count_by_kind[static_cast<int>(SpringKind::Bending)] += bends.size() + hinges.size();
     }
+    // A triangle mesh cloth (cloth.mesh): its particles are the mesh's vertices, rows = 1 and cols their count.
+    bool mesh = false;
+    bool material_weights = false;  // a mesh cloth's weights are the material form's (cloth_mesh.hpp)
+    // A mesh cloth's texture coordinates (m), one per particle: its rest shape projected on u_axis and on the
+    // direction across it in the mesh's mean plane (the weave's warp and weft). Empty for a grid (grid_uv).
+    std::vector<glm::vec2> uv;
 };
 
 // Per component, the smallest and largest motion of one substep (pinned and absent particles' zero included).

@@ -225,7 +225,10 @@ void pins_to_scene(AppState& app) {
     if (soft.empty()) app.scene.pins.clip = ClipKind::Rigid;  // no clip left to hold softly (validate refuses it)
     app.scene.pins.particles = std::move(soft);
     for (std::size_t i = 0; i < app.sim.particle_count(); ++i) {  // every particle a clip holds, one by one
-        if (app.sim.state().pinned[i] == kPinned) {
+        if (app.sim.state().pinned[i] != kPinned) continue;
+        if (app.sim.topology().mesh) {  // a mesh cloth's pins name vertices
+            app.scene.pins.particles.push_back({0, 0, 0.0f, static_cast<int>(i)});
+        } else {
             app.scene.pins.particles.push_back({static_cast<int>(i) / cols, static_cast<int>(i) % cols});
         }
     }

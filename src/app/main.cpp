@@ -4,8 +4,10 @@
 #include "exit_codes.hpp"
 #include "headless.hpp"
 
+#include "clothsim/cloth_mesh.hpp"
 #include "clothsim/mass_spring.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -205,6 +207,11 @@ int run(CommandLine& cl) {
     Scene scene = load_scene(cl.scene_name);
     for (const std::string& assignment : cl.overrides) apply_override(scene, assignment);
     if (cl.print_scene) {
+        if (scene.cloth.is_mesh()) {
+            const MassSpring sim = build_simulation(scene);
+            std::cout << "# " << cloth_mesh_summary(sim.topology(), sim.particle_count(), stability_limit(sim).critical_substep)
+                      << "\n";
+        }
         std::cout << to_toml(scene);
         return kExitOk;
     }

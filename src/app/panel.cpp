@@ -4,6 +4,7 @@
 #include "app_state.hpp"
 #include "layout.hpp"
 
+#include "clothsim/cloth_mesh.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/mesh_file.hpp"
 #include "clothsim/overloaded.hpp"
@@ -178,7 +179,9 @@ bool value_widget(Scene& edit, const FieldInfo& f) {
             [&](std::string* v) {
                 char buffer[256];
                 std::snprintf(buffer, sizeof buffer, "%s", v->c_str());
-                if (ImGui::InputText(label.c_str(), buffer, sizeof buffer)) {
+                // A file is read when the name is complete (Enter), not at every key.
+                const ImGuiInputTextFlags flags = f.name == "cloth.mesh" ? ImGuiInputTextFlags_EnterReturnsTrue : 0;
+                if (ImGui::InputText(label.c_str(), buffer, sizeof buffer, flags)) {
                     *v = buffer;
                     return true;
                 }
@@ -252,13 +255,36 @@ bool field_row(Scene& edit, AppState& app, const FieldInfo& f) {
     const Integrator integrator = edit.settings.integration.integrator;
     const bool unused = (f.name == "integration.tolerance" && !uses_tolerance(integrator)) ||
                         (f.name == "integration.iterations" && !uses_iterations(integrator));
+    // A mesh cloth does not read the grid's fields, nor a grid the mesh's placement.
+    const bool grid_field = f.name == "cloth.rows" || f.name == "cloth.cols" || f.name == "cloth.size" ||
+                            f.name == "cloth.shape" || f.name == "cloth.v_axis";
+    const bool mesh_field = f.name == "cloth.mesh_rotation" || f.name == "cloth.mesh_scale";
+    const bool unread = edit.cloth.is_mesh() ? grid_field : mesh_field;
     bool changed = false;
     if (owned) ImGui::BeginDisabled();
-    if (unused) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, ImGui::GetStyle().Alpha * 0.45f);
+    if (unused || unread) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, ImGui::GetStyle().Alpha * 0.45f);
     if (owned ? value_widget(edit, f) : field_widget(edit, app.loaded, f)) {
         keep_in_range(app, edit, f);
         note_edit(edit, f);
         changed = true;
+        if (f.name == "cloth.mesh") {  // read the file now; a bad one is said and the cloth stays as it is
+            try {
+                load_cloth_mesh(edit.cloth, scene_file_directory(app.scene_source));
+            } catch (const SceneError& e) {
+                app.say(e.what());
+                edit.cloth.mesh = app.document().cloth.mesh;
+                edit.cloth.mesh_data = app.document().cloth.mesh_data;
+                changed = false;
+            }
+        }
+    }
+    if (unread) {
+        ImGui::PopStyleVar();
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip(edit.cloth.is_mesh() ? "a mesh cloth (cloth.mesh) does not read %s"
+                                                   : "%s places a mesh cloth; this cloth is a grid (cloth.mesh = \"\")",
+                              std::string(f.name).c_str());
+        }
     }
     if (unused) {
         ImGui::PopStyleVar();
@@ -390,6 +416,16 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
     if (edit.material.enabled) {
         if (named_fields(edit, app, {"material.density", "material.stretch", "material.shear", "material.bending"})) {
             result = FabricEdit::Live;
+        }
+        if (app.sim.topology().mesh) {
+            // Two lines, as the grid's below, so nothing moves between scenes.
+            ImGui::TextDisabled("mesh: van Gelder springs on the edges, Bergou hinges across them");
+            ImGui::TextDisabled("shear follows stretch on a mesh (3/8 of it): shear has no effect");
+            if (ImGui::IsItemHovered()) {
+                ImGui::SetTooltip("Springs on triangles are a central-force lattice: its shear stiffness is 3/8 of\n"
+                                  "its tensile stiffness (the Cauchy relation). docs/MESH_CLOTH.md");
+            }
+            return result;
         }
         try {
             const SpringConstants k = spring_constants(edit.cloth, edit.material);
@@ -923,7 +959,12 @@ PanelRequests draw_panel(AppState& app, float content_scale) {
     if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) scene_section(app, requests);
     bool cloth_changed = false;
     if (ImGui::CollapsingHeader("Cloth")) {
-        ImGui::TextDisabled("grid, shape and pins: changes rebuild the cloth");
+        ImGui::TextDisabled("grid, shape, mesh and pins: changes rebuild the cloth");
+        if (app.sim.topology().mesh) {
+            const std::string summary = cloth_mesh_summary(app.sim.topology(), app.sim.particle_count(),
+                                                           app.stepper.limit(app.sim).critical_substep);
+            ImGui::TextDisabled("%s", summary.c_str());
+        }
         cloth_changed |= fields_section(edit, app, "cloth.");
         cloth_changed |= fields_section(edit, app, "pins");
     }

@@ -172,8 +172,12 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
         MeshData data;
         data.positions = vertices;
         data.normals = normals_;
-        for (int r = 0; r < t.rows; ++r) {
-            for (int c = 0; c < t.cols; ++c) data.uvs.push_back(grid_uv(t, glm::vec2(float(c), float(r))));
+        if (t.mesh) {
+            data.uvs = t.uv;  // in metres
+        } else {
+            for (int r = 0; r < t.rows; ++r) {
+                for (int c = 0; c < t.cols; ++c) data.uvs.push_back(grid_uv(t, glm::vec2(float(c), float(r))));
+            }
         }
         for (const glm::vec2& grid : surface.split_grid) data.uvs.push_back(grid_uv(t, grid));
         for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
@@ -182,7 +186,9 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
         cloth_.emplace(data, true);
         // The weave repeats every 12 cm of cloth, whatever the grid's resolution or aspect.
         glm::vec2 extent(0.0f);
-        if (!positions_.empty()) {
+        if (t.mesh) {
+            extent = glm::vec2(1.0f);  // the mesh's coordinates are metres already
+        } else if (!positions_.empty()) {
             extent = {glm::length(positions_[t.index(0, t.cols - 1)] - positions_[0]),
                       glm::length(positions_[t.index(t.rows - 1, 0)] - positions_[0])};
         }

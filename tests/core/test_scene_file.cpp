@@ -798,7 +798,7 @@ TEST_CASE("scene pins: a bad clip is rejected with its line, the part at fault a
 
     // Unknown keys, in a clip and in the pins table, with the keys that are known.
     CHECK_THAT(parse_error("pins = [{ particle = [0, 0], radios = 0.1 }]\n"),
-               Contains("pins[0] has an unknown key 'radios'; allowed keys: particle, radius"));
+               Contains("pins[0] has an unknown key 'radios'; allowed keys: particle, vertex, radius"));
     CHECK_THAT(parse_error("pins = { preset = \"none\", grip = 0.1 }\n"),
                Contains("pins has an unknown key 'grip'; allowed keys: preset, radius, particles, clip"));
     // A clip kind that is not one.

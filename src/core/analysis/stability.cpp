@@ -101,6 +101,13 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         row_sum[b.m] += 8.0 * k;
         row_sum[b.b] += 4.0 * k;
     }
+    // A hinge's Hessian k c c^T: absolute row sums k |c_i| sum_j |c_j|.
+    for (const Hinge& h : topology.hinges) {
+        const double k = stiffness_of(settings.springs, h);
+        const double total = std::abs(double(h.c[0])) + std::abs(double(h.c[1])) + std::abs(double(h.c[2])) +
+                             std::abs(double(h.c[3]));
+        for (int i = 0; i < 4; ++i) row_sum[h.v[i]] += k * std::abs(double(h.c[i])) * total;
+    }
     for (const SoftClipSpring& h : topology.clip_springs) row_sum[h.particle] += h.stiffness;
     double gershgorin = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
@@ -113,6 +120,9 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double sum_k = double(std::max(k.structural.x, k.structural.y)) + double(k.shear) + bending;
     limit.omega_gershgorin = std::sqrt(gershgorin);
     limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest + hold_rate) : 0.0;
+    // A mesh cloth has no grid lines for a plane wave to run along, and its settings hold moduli, not springs'
+    // k: its bound is the Gershgorin one.
+    if (topology.mesh) limit.omega_plane_wave = limit.omega_gershgorin;
     const double factor = info.spring_factor;
     const DampingForm form = info.explicit_damping ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);

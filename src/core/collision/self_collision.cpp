@@ -52,7 +52,7 @@ double particle_spacing(const Topology& topology) {
 
 SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_position)
     : rows_(topology.rows), cols_(topology.cols), particles_(rest_position.size()) {
-    grid_ = rows_ > 0 && cols_ > 0 && static_cast<std::size_t>(rows_) * cols_ == particles_;
+    grid_ = !topology.mesh && rows_ > 0 && cols_ > 0 && static_cast<std::size_t>(rows_) * cols_ == particles_;
     if (grid_) {
         tile_rows_ = (rows_ + kSelfTile - 1) / kSelfTile;
         tile_cols_ = (cols_ + kSelfTile - 1) / kSelfTile;
@@ -117,6 +117,9 @@ void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array
             link(b.m, b.b);
             link(b.a, b.b);
         }
+        for (const Hinge& h : topology.hinges) {
+            for (const auto& [a, b] : {std::pair{0, 1}, {0, 2}, {1, 2}, {0, 3}, {1, 3}, {2, 3}}) link(h.v[a], h.v[b]);
+        }
     };
     each_link([&](std::uint32_t a, std::uint32_t b) { ++begin[a + 1], ++begin[b + 1]; });
     for (std::size_t i = 0; i < particles_; ++i) begin[i + 1] += begin[i];
@@ -155,6 +158,7 @@ void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array
         if (spring.kind == SpringKind::Bending) bending.push_back(pair_key(spring.a, spring.b));
     }
     for (const Bend& b : topology.bends) bending.push_back(pair_key(b.a, b.b));
+    for (const Hinge& h : topology.hinges) bending.push_back(pair_key(h.v[2], h.v[3]));
     if (!grid_ || far_links_) {  // fold_pair() searches the list
         std::sort(bending.begin(), bending.end());
         bending.erase(std::unique(bending.begin(), bending.end()), bending.end());

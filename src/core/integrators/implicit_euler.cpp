@@ -45,6 +45,15 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
         out.add(b.m, 2.0f * e);
         out.add(b.b, -e);
     }
+    // Hinges are linear too: K u = -k c_i (sum_j c_j u_j) on v_i.
+    for (const Hinge& h : topology.hinges) {
+        const float k = stiffness_of(springs, h);
+        if (k == 0.0f) continue;
+        glm::vec3 sum(0.0f);
+        for (int i = 0; i < 4; ++i) sum += h.c[i] * u.get(h.v[i]);
+        const glm::vec3 e = k * sum;
+        for (int i = 0; i < 4; ++i) out.add(h.v[i], -h.c[i] * e);
+    }
 }
 
 double dot(const Vec3Array& a, const Vec3Array& b) {

@@ -65,6 +65,7 @@ LinearSolve step_implicit_euler(State& state, const Dynamics& dynamics, const To
 struct XpbdMultipliers {
     std::vector<double> spring;     // per spring
     std::vector<glm::dvec3> bend;   // per bend (a vector constraint)
+    std::vector<glm::dvec3> hinge;  // per hinge (a vector constraint)
     double substep = 0.0;           // s
     double initial_violation = 0.0; // |C| at the prediction, over all springs and bends
 };

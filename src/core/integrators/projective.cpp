@@ -105,7 +105,7 @@ std::shared_ptr<const ProjectiveSolver::Factor> factorise(const State& state, co
     const double inertia_scale = (1.0 + h_hat * damping) / (h_hat * h_hat);
     f->inertia.resize(rows);
     std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(rows + 4 * topology.springs.size() + 9 * topology.bends.size());
+    entries.reserve(rows + 4 * topology.springs.size() + 9 * topology.bends.size() + 16 * topology.hinges.size());
     for (int r = 0; r < rows; ++r) {
         f->inertia[r] = inertia_scale * state.mass[f->particle[r]];
         entries.emplace_back(r, r, f->inertia[r]);
@@ -139,6 +139,14 @@ std::shared_ptr<const ProjectiveSolver::Factor> factorise(const State& state, co
         const double w[3] = {1.0, -2.0, 1.0};
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) add(p[i], p[j], k * w[i] * w[j]);
+        }
+    }
+    // A hinge's energy 0.5 k |sum_i c_i x_i|^2 adds k c c^T on its four particles; quadratic like a bend.
+    for (const Hinge& h : topology.hinges) {
+        const double k = stiffness_of(springs, h);
+        if (k == 0.0) continue;
+        for (int i = 0; i < 4; ++i) {
+            for (int j = 0; j < 4; ++j) add(h.v[i], h.v[j], k * double(h.c[i]) * double(h.c[j]));
         }
     }
     f->matrix.resize(rows, rows);
@@ -272,6 +280,10 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
         for (const Bend& b : topology.bends) {
             const glm::dvec3 d = bend_difference(position, b);
             e += 0.5 * double(stiffness_of(springs, b)) * glm::dot(d, d);
+        }
+        for (const Hinge& hinge : topology.hinges) {
+            const glm::dvec3 d = hinge_difference(position, hinge);
+            e += 0.5 * double(stiffness_of(springs, hinge)) * glm::dot(d, d);
         }
         for (const SoftClipSpring& hold : topology.clip_springs) {
             const glm::dvec3 d = position.get(hold.particle) - hold.anchor;

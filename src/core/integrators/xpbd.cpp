@@ -30,6 +30,7 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     // another order.
     multipliers.spring.assign(topology.springs.size(), 0.0);
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
+    multipliers.hinge.assign(topology.hinges.size(), glm::dvec3(0.0));
     double violation2 = 0.0;
     for (std::size_t j = 0; j < topology.springs.size(); ++j) {
         const Spring& s = topology.springs[j];
@@ -62,6 +63,22 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         state.position.add(b.m, (-2.0 * wm) * lambda);
         state.position.add(b.b, wb * lambda);
     }
+    // Hinges: the vector constraint C = sum_i c_i x_i with gradients c_i I:
+    // d_lambda = -C / (sum_i w_i c_i^2 + 1 / (k h^2)).
+    for (std::size_t j = 0; j < topology.hinges.size(); ++j) {
+        const Hinge& hinge = topology.hinges[j];
+        const double k = stiffness_of(springs, hinge);
+        if (k == 0.0) continue;
+        double w = 0.0;
+        for (int i = 0; i < 4; ++i) w += double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i]) * double(hinge.c[i]);
+        const glm::dvec3 c = hinge_difference(state.position, hinge);
+        const glm::dvec3 lambda = c * (-1.0 / (w + 1.0 / (k * h * h)));
+        multipliers.hinge[j] = lambda;
+        violation2 += (c.x * c.x + c.y * c.y) + c.z * c.z;
+        for (int i = 0; i < 4; ++i) {
+            state.position.add(hinge.v[i], (double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i])) * lambda);
+        }
+    }
     for (std::size_t i = 0; i < n; ++i) {
         state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));
     }
@@ -71,7 +88,8 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
 
 double xpbd_residual(const DVec3Array& position, const Topology& topology, const SpringSettings& springs,
                      const XpbdMultipliers& multipliers) {
-    if (multipliers.spring.size() != topology.springs.size() || multipliers.bend.size() != topology.bends.size()) {
+    if (multipliers.spring.size() != topology.springs.size() || multipliers.bend.size() != topology.bends.size() ||
+        multipliers.hinge.size() != topology.hinges.size()) {
         return 0.0;  // no XPBD substep yet
     }
     const double h2 = multipliers.substep * multipliers.substep;
@@ -89,6 +107,13 @@ double xpbd_residual(const DVec3Array& position, const Topology& topology, const
         const double k = stiffness_of(springs, b);
         if (k == 0.0) continue;
         const glm::dvec3 r = bend_difference(position, b) + multipliers.bend[j] / (k * h2);
+        residual2 += glm::dot(r, r);
+    }
+    for (std::size_t j = 0; j < topology.hinges.size(); ++j) {
+        const Hinge& hinge = topology.hinges[j];
+        const double k = stiffness_of(springs, hinge);
+        if (k == 0.0) continue;
+        const glm::dvec3 r = hinge_difference(position, hinge) + multipliers.hinge[j] / (k * h2);
         residual2 += glm::dot(r, r);
     }
     const double first = multipliers.initial_violation;

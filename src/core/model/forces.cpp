@@ -37,6 +37,12 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
         force.add(b.m, T(2) * e);
         force.add(b.b, -e);
     }
+    for (const Hinge& h : topology.hinges) {
+        const T kh = stiffness_of(springs, h);
+        if (kh == T(0)) continue;
+        const Vec e = kh * Vec(hinge_difference(position, h));
+        for (int i = 0; i < 4; ++i) force.add(h.v[i], -T(h.c[i]) * e);
+    }
 }
 
 glm::vec3 wind_velocity(const ForceSettings& forces, double time) {
@@ -107,6 +113,10 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
     for (const Bend& b : topology.bends) {
         const glm::dvec3 d = bend_difference(position, b);
         energy += 0.5 * double(stiffness_of(springs, b)) * glm::dot(d, d);
+    }
+    for (const Hinge& h : topology.hinges) {
+        const glm::dvec3 d = hinge_difference(position, h);
+        energy += 0.5 * double(stiffness_of(springs, h)) * glm::dot(d, d);
     }
     for (const SoftClipSpring& h : topology.clip_springs) {
         const glm::dvec3 d = position.get(h.particle) - h.anchor;

@@ -7,7 +7,8 @@
 namespace clothsim {
 
 // Hooke springs, F_a = k w (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b; then the bends
-// (spring.hpp): with d = x_a - 2 x_m + x_b, F_a = F_b = -k w d and F_m = 2 k w d. A spring with L0 = 0 uses
+// (spring.hpp): with d = x_a - 2 x_m + x_b, F_a = F_b = -k w d and F_m = 2 k w d; then the hinges: with
+// d = sum_i c_i x_i, F_i = -k c_i d. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
 // d is taken in double and rounded once to the force type F; the rest is computed in F. Instantiated for
@@ -34,7 +35,8 @@ template <class F>
 void accumulate_wind_forces(const Topology& topology, const State& state, const ForceSettings& forces,
                             double rest_area, BasicVec3Array<F>& force);
 
-// Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends and
+// Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends,
+// 0.5 k |sum_i c_i x_i|^2 over hinges and
 // 0.5 k |x - anchor|^2 over soft clips' holds (J).
 double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs);
@@ -54,6 +56,16 @@ inline float stiffness_of(const SpringSettings& springs, const Spring& s) {
 }
 inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
     return stiffness_of(springs, SpringKind::Bending, b.axis) * b.weight;
+}
+inline float stiffness_of(const SpringSettings& springs, const Hinge& h) {
+    return springs.bending.x * h.weight_u + springs.bending.y * h.weight_v;
+}
+// A hinge's sum_i c_i x_i (spring.hpp), in double.
+inline glm::dvec3 hinge_difference(const DVec3Array& position, const Hinge& h) {
+    // Relative to v[0], so the sum keeps the precision of the small differences (the weights sum to 0).
+    const glm::dvec3 o = position.get(h.v[0]);
+    return double(h.c[1]) * (position.get(h.v[1]) - o) + double(h.c[2]) * (position.get(h.v[2]) - o) +
+           double(h.c[3]) * (position.get(h.v[3]) - o);
 }
 // The second difference x_a - 2 x_m + x_b of a bend, in double: (x_a - x_m) + (x_b - x_m).
 inline glm::dvec3 bend_difference(const DVec3Array& position, const Bend& b) {

@@ -41,13 +41,20 @@ std::size_t break_springs(Topology& topology, const std::function<bool(const Spr
     auto bridges = [&](std::uint32_t a, std::uint32_t m, std::uint32_t b) {
         return broken.count(pair_key(a, m)) != 0 || broken.count(pair_key(m, b)) != 0;
     };
-    const std::size_t before = topology.springs.size() + topology.bends.size();
+    const std::size_t before = topology.springs.size() + topology.bends.size() + topology.hinges.size();
     std::erase_if(topology.springs, [&](const Spring& s) {
         if (s.kind != SpringKind::Bending) return broken.count(pair_key(s.a, s.b)) != 0;
-        return breaks(s) || (topology.cols > 0 && bridges(s.a, middle(topology, s.a, s.b), s.b));
+        return breaks(s) || (topology.cols > 0 && !topology.mesh && bridges(s.a, middle(topology, s.a, s.b), s.b));
     });
     std::erase_if(topology.bends, [&](const Bend& b) { return bridges(b.a, b.m, b.b); });
-    const std::size_t removed = before - topology.springs.size() - topology.bends.size();
+    // A hinge goes with its edge, or with either triangle it joins.
+    std::erase_if(topology.hinges, [&](const Hinge& h) {
+        for (const auto& [a, b] : {std::pair{0, 1}, {0, 2}, {1, 2}, {0, 3}, {1, 3}}) {
+            if (broken.count(pair_key(h.v[a], h.v[b])) != 0) return true;
+        }
+        return false;
+    });
+    const std::size_t removed = before - topology.springs.size() - topology.bends.size() - topology.hinges.size();
     if (removed == 0) return 0;
     const std::size_t triangles = topology.triangles.size();
     std::erase_if(topology.triangles, [&](const std::array<std::uint32_t, 3>& t) {

@@ -3,6 +3,7 @@
 #include "clothsim/scene.hpp"
 
 #include "scene/cloth_shape.hpp"
+#include "clothsim/cloth_mesh.hpp"
 #include "clothsim/material.hpp"
 
 #include <glm/geometric.hpp>
@@ -93,8 +94,44 @@ Topology grid_topology(const ShapeMask& shape, const DVec3Array& position, bool 
 
 // Every particle a pin of `pins` holds: visit(index, radius, distance), the distance at rest from the pin's
 // own particle (0 and 0 for a point pin).
+// A mesh cloth's pins: each names a vertex; a clip holds every vertex within its radius at rest.
+template <class Visit>
+void for_each_pinned_vertex(const ClothSettings& cloth, const PinSpec& pins, Visit&& visit) {
+    if (pins.preset != PinPreset::None) {
+        throw SceneError("pins: the preset \"" + std::string(pin_preset_names()[static_cast<int>(pins.preset)]) +
+                         "\" names places on a grid; a mesh cloth (cloth.mesh) is pinned by vertex: allowed: "
+                         "pins = [{ vertex = i }, ...] (i counted from 0), or pins = \"none\"");
+    }
+    const std::vector<glm::dvec3> rest = placed_cloth_vertices(cloth);
+    for (const Pin& p : pins.particles) {
+        if (p.vertex < 0) {
+            throw SceneError("pins: [" + std::to_string(p.row) + ", " + std::to_string(p.col) +
+                             "] names a grid particle; a mesh cloth (cloth.mesh) is pinned by vertex: allowed: "
+                             "{ vertex = i } or { vertex = i, radius = R }");
+        }
+        if (static_cast<std::size_t>(p.vertex) >= rest.size()) {
+            throw SceneError("pins: vertex " + std::to_string(p.vertex) + " is not a vertex of " + cloth.mesh +
+                             "; allowed: a vertex in [0, " + std::to_string(rest.size() - 1) + "]");
+        }
+        if (!(p.radius > 0.0f)) {
+            visit(static_cast<std::size_t>(p.vertex), 0.0, 0.0);
+            continue;
+        }
+        const double reach = double(p.radius) * (1.0 + 1e-6);  // the rim counts, as on the grid
+        const glm::dvec3 centre = rest[static_cast<std::size_t>(p.vertex)];
+        for (std::size_t i = 0; i < rest.size(); ++i) {
+            const double d = glm::length(rest[i] - centre);
+            if (d <= reach) visit(i, double(p.radius), d);
+        }
+    }
+}
+
 template <class Visit>
 void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& visit) {
+    if (cloth.is_mesh()) {
+        for_each_pinned_vertex(cloth, pins, visit);
+        return;
+    }
     const int rows = cloth.rows, cols = cloth.cols;
     // A clip holds the particles within its radius at rest. Rest positions are build_simulation's:
     // origin + c du u + r dv v, u and v normalised, so particles dc columns and dr rows apart lie
@@ -144,7 +181,14 @@ void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& vi
             break;
         case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0, clip); break;
     }
-    for (const Pin& p : pins.particles) pin(p.row, p.col, p.radius);
+    // A grid's vertices are its particles, row-major.
+    for (const Pin& p : pins.particles) {
+        if (p.vertex >= 0 && cols > 0) {
+            pin(p.vertex / cols, p.vertex % cols, p.radius);
+        } else {
+            pin(p.row, p.col, p.radius);
+        }
+    }
 }
 
 }  // namespace
@@ -201,6 +245,37 @@ std::vector<float> particle_masses(const Scene& scene, const ShapeMask& shape) {
 
 void apply_fabric(MassSpring& sim, const Scene& scene) {
     const Topology& topology = sim.topology();
+    if (topology.mesh || scene.cloth.is_mesh()) {
+        const std::size_t n = scene.cloth.mesh_data ? scene.cloth.mesh_data->vertices().size() : 0;
+        if (!topology.mesh || !scene.cloth.is_mesh() || n != sim.particle_count()) {
+            throw SceneError("the fabric of another cloth cannot be put on the running one: rebuild it");
+        }
+        // The mesh's weights hold its geometry in the form it was built in (material or per spring).
+        if (topology.material_weights != scene.material.enabled) {
+            throw SceneError(std::string("switching a mesh cloth between [material] and per-spring values changes its "
+                                         "springs' and hinges' weights: rebuild the cloth"));
+        }
+        if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
+        Scene derived = scene;
+        derive_springs(derived);
+        SimulationSettings settings = sim.settings();
+        settings.springs.structural = derived.settings.springs.structural;
+        settings.springs.shear = derived.settings.springs.shear;
+        settings.springs.bending = derived.settings.springs.bending;
+        const std::vector<glm::dvec3> rest = placed_cloth_vertices(derived.cloth);
+        if (scene.material.enabled) {
+            sim.set_spring_weights(membrane_springs(rest, derived.cloth.mesh_data->triangles(), glm::dvec3(derived.cloth.u_axis),
+                                                    glm::dvec2(derived.material.stretch)));
+        }
+        const std::vector<double> area = vertex_areas(rest, derived.cloth.mesh_data->triangles());
+        double total = 0.0;
+        for (double a : area) total += a;
+        std::vector<float> mass(area.size());
+        for (std::size_t i = 0; i < area.size(); ++i) mass[i] = static_cast<float>(double(derived.cloth.mass) * area[i] / total);
+        sim.set_masses(mass);
+        sim.apply(settings);
+        return;
+    }
     if (topology.rows != scene.cloth.rows || topology.cols != scene.cloth.cols) {
         throw SceneError("the fabric of a " + std::to_string(scene.cloth.rows) + " x " +
                          std::to_string(scene.cloth.cols) + " cloth cannot be put on the running " +
@@ -223,8 +298,69 @@ void apply_fabric(MassSpring& sim, const Scene& scene) {
     sim.apply(settings);
 }
 
+void validate_mesh_cloth(const Scene& scene) {
+    const ClothSettings& cloth = scene.cloth;
+    if (!cloth.mesh_data) {
+        throw SceneError("cloth.mesh = \"" + cloth.mesh + "\" holds no mesh; allowed: a Wavefront OBJ file that loads");
+    }
+    if (cloth.mesh_data->vertices().size() > static_cast<std::size_t>(kMaxParticles)) {
+        throw SceneError("cloth.mesh = \"" + cloth.mesh + "\" has " + std::to_string(cloth.mesh_data->vertices().size()) +
+                         " vertices, too many particles; allowed: at most " + std::to_string(kMaxParticles));
+    }
+    pinned_particles(cloth, scene.pins);  // throws for a pin that names no vertex
+}
+
+namespace {
+
+// A mesh cloth (cloth_mesh.hpp): particles at the placed vertices, the mesh model's springs and hinges.
+MassSpring build_mesh_simulation(const Scene& scene) {
+    const ClothSettings& cloth = scene.cloth;
+    const std::vector<glm::dvec3> rest = placed_cloth_vertices(cloth);
+    const auto& triangles = cloth.mesh_data->triangles();
+    const std::size_t n = rest.size();
+    State state;
+    state.position.resize(n);
+    for (std::size_t i = 0; i < n; ++i) state.position.set(i, rest[i]);
+    Scene derived = scene;
+    derive_springs(derived);
+    const std::vector<double> area = vertex_areas(rest, triangles);
+    double total_area = 0.0;
+    for (double a : area) total_area += a;
+    // The material's density, or cloth.mass in proportion to area (the same thing: derive_springs sets cloth.mass
+    // to density x area).
+    const double per_area = double(derived.cloth.mass) / total_area;
+    state.mass.resize(n);
+    state.inverse_mass.resize(n);
+    state.pinned.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        state.mass[i] = static_cast<float>(per_area * area[i]);
+        state.inverse_mass[i] = 1.0f / state.mass[i];
+    }
+    for (std::size_t i : pinned_particles(cloth, scene.pins)) {
+        state.pinned[i] = kPinned;
+        state.inverse_mass[i] = 0.0f;
+    }
+    Topology topology = mesh_topology(rest, triangles, glm::dvec3(cloth.u_axis),
+                                      scene.material.enabled ? std::optional(glm::dvec2(derived.material.stretch)) : std::nullopt);
+    // Soft clips as on the grid: k = kappa A w, kappa = kClipHoldFactor E / R^2, A the vertex's area, E the
+    // springs' stretch along u and v (springs.structural on a mesh).
+    for (const ClipWeight& w : soft_clip_weights(cloth, scene.pins)) {
+        if (state.pinned[w.particle] != 0) continue;
+        const double share = kClipHoldFactor / (w.radius * w.radius) * area[w.particle] * w.weight;
+        SoftClipSpring hold{static_cast<std::uint32_t>(w.particle), 0.0f, state.position.get(w.particle),
+                            static_cast<float>(share), static_cast<float>(share)};
+        hold.stiffness = hold.stiffness_for(derived.settings.springs.structural);
+        if (share > 0.0) topology.clip_springs.push_back(hold);
+    }
+    std::vector<glm::vec3> velocity(n, cloth.velocity);
+    return MassSpring(std::move(topology), std::move(state), derived.settings, velocity);
+}
+
+}  // namespace
+
 MassSpring build_simulation(const Scene& scene) {
     validate(scene);
+    if (scene.cloth.is_mesh()) return build_mesh_simulation(scene);
     const ClothSettings& cloth = scene.cloth;
     const std::size_t n = static_cast<std::size_t>(cloth.rows) * cloth.cols;
     const glm::vec3 u = glm::normalize(cloth.u_axis);

@@ -14,7 +14,11 @@ namespace clothsim {
 bool write_obj(const MassSpring& sim, const std::string& path, std::string& error, bool colliders) {
     std::ostringstream out;
     const Topology& t = sim.topology();
-    out << "# clothsim mesh: " << t.rows << " x " << t.cols << " particles, t = " << sim.time() << " s\n";
+    if (t.mesh) {
+        out << "# clothsim mesh: a mesh cloth of " << sim.particle_count() << " particles, t = " << sim.time() << " s\n";
+    } else {
+        out << "# clothsim mesh: " << t.rows << " x " << t.cols << " particles, t = " << sim.time() << " s\n";
+    }
     out.precision(9);
     if (colliders) out << "o cloth\n";
     // A torn cloth is written split along its tears (cloth_surface.hpp): its split vertices follow the particles.
@@ -27,8 +31,11 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
         out << "vt " << texture.x << ' ' << texture.y << '\n';
     };
     // UVs come from the grid: a topology that is not a grid of its particles is written without them.
-    const bool grid = static_cast<std::size_t>(t.rows) * static_cast<std::size_t>(t.cols) == sim.particle_count();
-    if (grid) {
+    // A mesh cloth's are its own (metres of cloth, Topology::uv).
+    const bool grid = t.mesh || static_cast<std::size_t>(t.rows) * static_cast<std::size_t>(t.cols) == sim.particle_count();
+    if (t.mesh) {
+        for (const glm::vec2& texture : t.uv) out << "vt " << texture.x << ' ' << texture.y << '\n';
+    } else if (grid) {
         for (int r = 0; r < t.rows; ++r) {
             for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
         }

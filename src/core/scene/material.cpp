@@ -2,6 +2,7 @@
 
 #include "scene/cloth_shape.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/cloth_mesh.hpp"
 
 #include <array>
 #include <algorithm>
@@ -149,6 +150,20 @@ void note_field_set(Scene& scene, std::string_view field) {
 
 void derive_springs(Scene& scene) {
     if (!scene.material.enabled || !material_clash(scene).empty()) return;
+    if (scene.cloth.is_mesh()) {
+        // A mesh cloth's elements carry their geometry in their weights (cloth_mesh.hpp): the springs' k is the
+        // stretch times theirs, the hinges' the flexural rigidity times theirs.
+        SpringSettings& s = scene.settings.springs;
+        s.structural = scene.material.stretch;
+        s.shear = scene.material.shear;
+        s.bending = scene.material.bending;
+        double area = 0.0;
+        if (scene.cloth.mesh_data) {
+            for (double a : vertex_areas(placed_cloth_vertices(scene.cloth), scene.cloth.mesh_data->triangles())) area += a;
+        }
+        if (area > 0.0) scene.cloth.mass = static_cast<float>(double(scene.material.density) * area);
+        return;
+    }
     const SpringConstants k = spring_constants(scene.cloth, scene.material);
     SpringSettings& s = scene.settings.springs;
     s.structural = glm::vec2(k.structural);

@@ -1,5 +1,7 @@
 #include "clothsim/mesh_file.hpp"
 
+#include "clothsim/cloth_mesh.hpp"
+
 #include "clothsim/collider.hpp"
 #include "clothsim/data_dirs.hpp"
 #include "clothsim/scene.hpp"
@@ -161,6 +163,19 @@ std::filesystem::path scene_file_directory(std::string_view scene_source) {
     std::error_code ec;
     const std::filesystem::path source(scene_source);
     return std::filesystem::is_regular_file(source, ec) ? source.parent_path() : std::filesystem::path();
+}
+
+void load_cloth_mesh(ClothSettings& cloth, const std::filesystem::path& scene_directory) {
+    if (cloth.mesh.empty()) {
+        cloth.mesh_data.reset();
+        return;
+    }
+    const std::filesystem::path path = find_mesh_file(cloth.mesh, scene_directory);
+    std::shared_ptr<const TriangleMesh> mesh = read_mesh_file(path);
+    if (const std::string problem = cloth_mesh_problem(mesh->vertices(), mesh->triangles()); !problem.empty()) {
+        throw SceneError(path.string() + " cannot be a cloth: " + problem);
+    }
+    cloth.mesh_data = std::move(mesh);
 }
 
 void load_collider_mesh(MeshCollider& collider, const std::filesystem::path& scene_directory) {

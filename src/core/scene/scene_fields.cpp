@@ -3,6 +3,7 @@
 #include "clothsim/scene.hpp"
 
 #include "scene/cloth_shape.hpp"
+#include "clothsim/cloth_mesh.hpp"
 #include "clothsim/collider_motion.hpp"
 #include "clothsim/material.hpp"
 #include "clothsim/overloaded.hpp"
@@ -31,10 +32,13 @@ const std::array kFields = {
     FieldInfo{"cloth.cols", "", 1, 2048, "particles along u_axis", [](Scene& s) -> FieldRef { return &s.cloth.cols; }},
     FieldInfo{"cloth.size", "m", 1e-3, 1e3, "[width along u_axis, height along v_axis]; one number for a square", [](Scene& s) -> FieldRef { return &s.cloth.size; }},
     FieldInfo{"cloth.mass", "kg", 1e-6, 1e6, "total mass, shared equally by all particles (derived from material.density when the scene has [material])", [](Scene& s) -> FieldRef { return &s.cloth.mass; }},
-    FieldInfo{"cloth.origin", "m", -kBig, kBig, "position of particle (row 0, col 0)", [](Scene& s) -> FieldRef { return &s.cloth.origin; }},
+    FieldInfo{"cloth.origin", "m", -kBig, kBig, "position of particle (row 0, col 0); for a mesh cloth, where the mesh's origin goes", [](Scene& s) -> FieldRef { return &s.cloth.origin; }},
     FieldInfo{"cloth.u_axis", "", -1e3, 1e3, "direction of increasing column (normalised; not parallel to v_axis)", [](Scene& s) -> FieldRef { return &s.cloth.u_axis; }},
     FieldInfo{"cloth.v_axis", "", -1e3, 1e3, "direction of increasing row (normalised)", [](Scene& s) -> FieldRef { return &s.cloth.v_axis; }},
     FieldInfo{"cloth.shape", "", 0, 0, "rectangle: the whole grid; disc: the particles inside the grid's inscribed circle (a Cusick drape specimen)", [](Scene& s) -> FieldRef { return &s.cloth.shape; }},
+    FieldInfo{"cloth.mesh", "", 0, 0, "a Wavefront OBJ file whose triangles are the cloth (beside the scene file, else a bundled mesh); \"\" = the rows x cols grid. Its vertices are the particles, pinned by index: pins = [{ vertex = 0 }]", [](Scene& s) -> FieldRef { return &s.cloth.mesh; }},
+    FieldInfo{"cloth.mesh_rotation", "degrees", -360, 360, "a mesh cloth turned about x, then y, then z (then moved by cloth.origin)", [](Scene& s) -> FieldRef { return &s.cloth.mesh_rotation; }},
+    FieldInfo{"cloth.mesh_scale", "", 1e-6, 1e4, "a mesh cloth's units to metres", [](Scene& s) -> FieldRef { return &s.cloth.mesh_scale; }},
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
     FieldInfo{"material.enabled", "", 0, 0, "whether [material] describes the cloth (any other material field turns it on); false returns to the per-spring form, keeping the mass and spring constants derived on this grid", [](Scene& s) -> FieldRef { return &s.material.enabled; }},
@@ -60,7 +64,7 @@ const std::array kFields = {
     FieldInfo{"forces.gust_frequency", "Hz", 0, 100, "main gust frequency", [](Scene& s) -> FieldRef { return &s.settings.forces.gust_frequency; }},
     FieldInfo{"forces.max_speed", "m/s", 0, 1e4, "0 = off; else every particle's speed is clamped to this", [](Scene& s) -> FieldRef { return &s.settings.forces.max_speed; }},
 
-    FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest; the table's radius makes each preset pin a clip; clip = \"soft\" holds a clip's particles by springs that fade to 0 at its rim instead of pinning them (the load enters the cloth smoothly)", [](Scene& s) -> FieldRef { return &s.pins; }},
+    FieldInfo{"pins", "", 0, 0, "a preset name, a list of pins, or { preset = NAME, radius = R, particles = [...] }; a pin is [row, col] or a clip { particle = [row, col], radius = R } holding every particle within R m of it at rest, or { vertex = i } (with a radius: a clip), a mesh cloth's vertex or a grid's row-major particle; the table's radius makes each preset pin a clip; clip = \"soft\" holds a clip's particles by springs that fade to 0 at its rim instead of pinning them (the load enters the cloth smoothly)", [](Scene& s) -> FieldRef { return &s.pins; }},
 
     FieldInfo{"colliders.thickness", "m", 0, 1, "distance particles keep from every collider surface", [](Scene& s) -> FieldRef { return &s.settings.colliders.thickness; }},
     FieldInfo{"colliders.contact", "", 0, 0, "projection: particles are moved out of the thickness shell after each substep, with Coulomb friction and continuous collision; penalty: a smooth force contact_stiffness x depth^3 / thickness^2 pushes them out (frictionless: friction is ignored; no continuous collision; thickness > 0)", [](Scene& s) -> FieldRef { return &s.settings.colliders.contact; }},
@@ -159,7 +163,7 @@ std::string describe_allowed_as(std::string_view unit_name, double min, double m
             [&](std::string*) { return std::string("a string"); },
             [&](PinSpec*) {
                 return cat("one of ", join(kPinPresetNames),
-                           ", a list of [row, col] or { particle = [row, col], radius = R }, or a table with preset, "
+                           ", a list of [row, col], { particle = [row, col], radius = R } or { vertex = i, radius = R }, or a table with preset, "
                            "radius, particles and clip (rigid or soft); R: ",
                            describe_pin_radius(), " (0 = a point pin)");
             },
@@ -232,8 +236,12 @@ std::string format_ref(ConstFieldRef value) {
                 std::string list;
                 for (const Pin& p : v->particles) {
                     const std::string cell = cat("[", std::to_string(p.row), ", ", std::to_string(p.col), "]");
-                    const std::string pin =
+                    std::string pin =
                         p.radius == 0.0f ? cell : cat("{ particle = ", cell, ", radius = ", number(p.radius), " }");
+                    if (p.vertex >= 0) {
+                        pin = cat("{ vertex = ", std::to_string(p.vertex),
+                                  p.radius == 0.0f ? std::string() : cat(", radius = ", number(p.radius)), " }");
+                    }
                     list += cat(list.empty() ? "" : ", ", pin);
                 }
                 return cat(out, ", particles = [", list, "] }");
@@ -282,13 +290,13 @@ void validate(const Scene& scene) {
     if (glm::length(glm::cross(c.u_axis / lu, c.v_axis / lv)) < 1e-3f) {
         throw SceneError("cloth.u_axis and cloth.v_axis are parallel; allowed: two non-parallel directions");
     }
-    if (c.shape == ClothShape::Disc && shape_mask(c).cell_count == 0) {
+    if (!c.is_mesh() && c.shape == ClothShape::Disc && shape_mask(c).cell_count == 0) {
         throw SceneError("cloth.shape = \"disc\" keeps no whole cell of the " + std::to_string(c.rows) + " x " +
                          std::to_string(c.cols) + " grid; allowed: a grid whose inscribed circle holds a cell (5 x 5 "
                          "particles or more)");
     }
     if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
-    if (scene.material.enabled) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive
+    if (scene.material.enabled && !c.is_mesh()) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive
     const ColliderSettings& colliders = scene.settings.colliders;
     if (colliders.contact == ContactModel::Penalty && !(colliders.thickness > 0.0f)) {
         throw SceneError("colliders.thickness = " + format_value(scene, *find_field("colliders.thickness")) +
@@ -336,9 +344,24 @@ void validate(const Scene& scene) {
         throw SceneError("pins: clip = \"soft\" has no clip to hold softly: no pin has a radius; allowed with "
                          "clip = \"soft\": pins.radius > 0 or a pin { particle = [row, col], radius = R } with R > 0");
     }
+    if (c.is_mesh()) {
+        validate_mesh_cloth(scene);
+        for (const Pin& pin : scene.pins.particles) {
+            check_radius(pin.radius, cat("the radius of the clip at vertex ", std::to_string(pin.vertex)));
+        }
+        return;
+    }
     for (const Pin& pin : scene.pins.particles) {
         const int r = pin.row, col = pin.col;
         check_radius(pin.radius, cat("the radius of the clip at [", std::to_string(r), ", ", std::to_string(col), "]"));
+        if (pin.vertex >= 0) {  // a grid's vertices are its particles, row-major
+            if (static_cast<long long>(pin.vertex) >= static_cast<long long>(c.rows) * c.cols) {
+                throw SceneError("pins: vertex " + std::to_string(pin.vertex) + " is not a particle of the " +
+                                 std::to_string(c.rows) + " x " + std::to_string(c.cols) + " grid; allowed: a vertex in [0, " +
+                                 std::to_string(static_cast<long long>(c.rows) * c.cols - 1) + "] (row-major)");
+            }
+            continue;
+        }
         if (r < 0 || r >= c.rows || col < 0 || col >= c.cols) {
             throw SceneError("pins: particle [" + std::to_string(r) + ", " + std::to_string(col) +
                              "] is outside the " + std::to_string(c.rows) + " x " + std::to_string(c.cols) +

@@ -112,7 +112,7 @@ struct Rejection {
     const toml::node* at = nullptr;
 };
 
-constexpr const char* kClipForm = "{ particle = [row, col], radius = R }";
+constexpr const char* kClipForm = "{ particle = [row, col], radius = R }, or on a mesh cloth { vertex = i } or { vertex = i, radius = R }";
 
 // A clip's radius: a number in [0, kMaxPinRadius] m.
 std::optional<float> pin_radius_of(const toml::node& node, const std::string& name, Rejection& rejection) {
@@ -158,20 +158,35 @@ std::optional<Pin> pin_of(const toml::node& node, const std::string& name, Rejec
     }
     std::optional<std::pair<int, int>> cell;
     float radius = 0.0f;
+    int vertex = -1;
     for (auto&& [key, value] : *table) {
         if (key.str() == "particle") {
             cell = pin_cell_of(value, name + ".particle", rejection);
             if (!cell) return std::nullopt;
+        } else if (key.str() == "vertex") {
+            const std::optional<std::int64_t> i = value.value<std::int64_t>();
+            if (!value.is_integer() || !i || *i < 0 || *i >= static_cast<std::int64_t>(kMaxParticles)) {
+                rejection = {name + ".vertex = " + show(value) + " is not a vertex index; allowed: an integer in [0, " +
+                                 std::to_string(kMaxParticles - 1) + "], counted from 0",
+                             &value};
+                return std::nullopt;
+            }
+            vertex = static_cast<int>(*i);
         } else if (key.str() == "radius") {
             const auto r = pin_radius_of(value, name + ".radius", rejection);
             if (!r) return std::nullopt;
             radius = *r;
         } else {
-            rejection = {name + " has an unknown key '" + std::string(key.str()) + "'; allowed keys: particle, radius",
+            rejection = {name + " has an unknown key '" + std::string(key.str()) + "'; allowed keys: particle, vertex, radius",
                          &value};
             return std::nullopt;
         }
     }
+    if (cell && vertex >= 0) {
+        rejection = {name + " = " + show(node) + " names both a particle and a vertex; allowed: one of them", &node};
+        return std::nullopt;
+    }
+    if (vertex >= 0) return Pin{0, 0, radius, vertex};
     if (!cell) {
         rejection = {name + " = " + show(node) + " names no particle; allowed: " + kClipForm, &node};
         return std::nullopt;
@@ -470,6 +485,13 @@ void load_table(Scene& scene, const toml::table& table, const std::string& prefi
                                                         : ": " + rejection.why));
             }
             note_field_set(scene, name);
+            if (name == "cloth.mesh") {
+                try {
+                    load_cloth_mesh(scene.cloth, scene_file_directory(source));
+                } catch (const SceneError& e) {
+                    throw SceneError(where(source, node) + ": cloth.mesh = \"" + scene.cloth.mesh + "\": " + e.what());
+                }
+            }
         } else if (is_section(name)) {
             const toml::table* sub = node.as_table();
             if (!sub) {
@@ -646,6 +668,13 @@ void apply_override(Scene& scene, std::string_view assignment) {
                          (rejection.why.empty() ? "; allowed: " + allowed : ": " + rejection.why));
     }
     if (field) note_field_set(candidate, key);
+    if (field && field->name == "cloth.mesh") {
+        try {
+            load_cloth_mesh(candidate.cloth, {});
+        } catch (const SceneError& e) {
+            throw SceneError(source + ": " + e.what());
+        }
+    }
     // A mesh collider given another file reads it (relative to the working directory, then bundled).
     if (auto* mesh = edited ? std::get_if<MeshCollider>(&edited->shape) : nullptr; mesh && collider_field->name == "file") {
         try {
@@ -665,7 +694,7 @@ void apply_override(Scene& scene, std::string_view assignment) {
 
 std::string to_toml(const Scene& scene) {
     std::string out = "# clothsim scene (fields, units and ranges: docs/SCENE_FILES.md)\n";
-    if (scene.material.enabled && scene.cloth.rows > 1 && scene.cloth.cols > 1) {
+    if (scene.material.enabled && !scene.cloth.is_mesh() && scene.cloth.rows > 1 && scene.cloth.cols > 1) {
         if (const std::string note = spring_constants(scene.cloth, scene.material).note; !note.empty()) {
             out += "# material: " + note + "\n";
         }
@@ -674,7 +703,9 @@ std::string to_toml(const Scene& scene) {
     auto line = [&](const FieldInfo& f, std::string_view key) -> std::string {
         const std::string text = std::string(key) + " = " + format_value(scene, f);
         if (field_is_written(scene, f.name)) return text + "\n";
-        if (!f.name.starts_with("material.")) return "# " + text + "  (derived from [material] on this grid)\n";
+        if (!f.name.starts_with("material.")) {
+            return "# " + text + "  (derived from [material] on this " + (scene.cloth.is_mesh() ? "mesh" : "grid") + ")\n";
+        }
         return "";
     };
     for (const FieldInfo& f : scene_fields()) {

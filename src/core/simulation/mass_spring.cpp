@@ -17,6 +17,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <unordered_map>
 #include <atomic>
 #include <cmath>
 #include <stdexcept>
@@ -769,6 +770,38 @@ void MassSpring::set_masses(std::span<const float> mass) {
     // substep. The projective matrix holds the masses; the stability limit and the grab's cap follow them.
     in_->invalidate_iterative();
     if (in_->grab) in_->grab->force_limit = grab_force_limit(in_->grab->particle);
+    wake();
+    setup_stamp_ = next_stamp();
+}
+
+void MassSpring::set_spring_weights(std::span<const Spring> from) {
+    auto key = [](std::uint32_t a, std::uint32_t b) {
+        return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
+    };
+    std::unordered_map<std::uint64_t, float> weight;
+    weight.reserve(from.size());
+    for (const Spring& s : from) weight[key(s.a, s.b)] = s.weight;
+    std::vector<float> next(topology_.springs.size());
+    for (std::size_t j = 0; j < next.size(); ++j) {
+        const Spring& s = topology_.springs[j];
+        const auto found = weight.find(key(s.a, s.b));
+        if (found == weight.end() || !(std::isfinite(found->second) && found->second >= 0.0f)) {
+            throw std::invalid_argument("MassSpring::set_spring_weights: spring " + std::to_string(j) + " (" +
+                                        std::to_string(s.a) + ", " + std::to_string(s.b) + ") has " +
+                                        (found == weight.end() ? "no match" : "weight " + std::to_string(found->second)) +
+                                        "; allowed: finite and >= 0");
+        }
+        next[j] = found->second;
+    }
+    bool changed = false;
+    for (std::size_t j = 0; j < next.size(); ++j) {
+        changed = changed || topology_.springs[j].weight != next[j];
+        topology_.springs[j].weight = next[j];
+    }
+    if (!changed) return;
+    // The projective matrix and the stability limit hold the springs' k; the cloth wakes to feel them.
+    in_->invalidate_iterative();
+    replan();
     wake();
     setup_stamp_ = next_stamp();
 }

@@ -1,0 +1,317 @@
+// The mesh cloth's checks and model (cloth_mesh.hpp).
+#include "clothsim/cloth_mesh.hpp"
+
+#include "clothsim/scene.hpp"
+#include "clothsim/shapes/mesh.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+namespace clothsim {
+namespace {
+
+using Triangles = std::vector<std::array<std::uint32_t, 3>>;
+
+std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+    if (a > b) std::swap(a, b);
+    return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+// Every undirected edge with the triangles that have it (one or two once the mesh is checked), in the order
+// the edges first appear.
+struct EdgeUse {
+    std::uint32_t a = 0, b = 0;     // as the first triangle runs it
+    std::uint32_t triangle[2] = {0, 0};
+    int count = 0;
+    bool same_direction = false;    // the second triangle runs it a -> b too
+};
+std::vector<EdgeUse> edge_uses(const Triangles& triangles, std::uint32_t* third_triangle = nullptr) {
+    std::vector<EdgeUse> edges;
+    std::unordered_map<std::uint64_t, std::uint32_t> index;
+    index.reserve(triangles.size() * 2);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+            const auto [it, added] = index.try_emplace(edge_key(a, b), static_cast<std::uint32_t>(edges.size()));
+            if (added) {
+                edges.push_back({a, b, {t, 0}, 1, false});
+                continue;
+            }
+            EdgeUse& e = edges[it->second];
+            if (e.count == 1) {
+                e.triangle[1] = t;
+                e.same_direction = e.a == a;
+            } else if (third_triangle && e.count == 2) {
+                *third_triangle = t;
+            }
+            ++e.count;
+        }
+    }
+    return edges;
+}
+
+// 0-based, as pins count vertices, with the OBJ file's 1-based index.
+std::string vertex_name(std::size_t i) { return "vertex " + std::to_string(i) + " (OBJ index " + std::to_string(i + 1) + ")"; }
+
+std::string show(glm::dvec3 p) {
+    std::ostringstream out;
+    out.precision(6);
+    out << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+    return out.str();
+}
+
+// The angle's cotangent at corner p of triangle (p, q, r): cos / sin from the dot and cross products.
+double cotangent(glm::dvec3 p, glm::dvec3 q, glm::dvec3 r) {
+    const glm::dvec3 a = q - p, b = r - p;
+    return glm::dot(a, b) / glm::length(glm::cross(a, b));
+}
+
+}  // namespace
+
+std::vector<glm::dvec3> placed_cloth_vertices(const ClothSettings& cloth) {
+    std::vector<glm::dvec3> out;
+    if (!cloth.mesh_data) return out;
+    const glm::dmat3 turn = rotation_matrix(glm::dvec3(cloth.mesh_rotation));
+    const double scale = cloth.mesh_scale;
+    const glm::dvec3 origin(cloth.origin);
+    out.reserve(cloth.mesh_data->vertices().size());
+    for (const glm::dvec3& v : cloth.mesh_data->vertices()) out.push_back(turn * (v * scale) + origin);
+    return out;
+}
+
+std::string cloth_mesh_problem(const std::vector<glm::dvec3>& vertices, const Triangles& triangles) {
+    if (triangles.empty()) return "it has no triangles";
+    const std::size_t n = vertices.size();
+    double extent = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::dvec3 p = vertices[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            return vertex_name(i) + " is not finite";
+        }
+        extent = std::max({extent, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    }
+    std::vector<std::uint8_t> used(n, 0);
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const auto& tri = triangles[t];
+        for (std::uint32_t i : tri) {
+            if (i >= n) return "triangle " + std::to_string(t) + " names vertex " + std::to_string(i) + " of " + std::to_string(n);
+            used[i] = 1;
+        }
+        const std::string corners = " (vertices " + std::to_string(tri[0]) + ", " + std::to_string(tri[1]) + ", " +
+                                    std::to_string(tri[2]) + ")";
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+            return "triangle " + std::to_string(t) + corners + " repeats a vertex";
+        }
+        const glm::dvec3 a = vertices[tri[0]], b = vertices[tri[1]], c = vertices[tri[2]];
+        const double twice_area = glm::length(glm::cross(b - a, c - a));
+        const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+        // No area, relative to its longest edge: a sliver 1e-6 as high as it is long has no direction to bend in.
+        if (!(twice_area > 1e-6 * longest * longest)) {
+            return "triangle " + std::to_string(t) + corners + " is degenerate (no area)";
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!used[i]) return vertex_name(i) + " is in no triangle";
+    }
+    // Two vertices at one place, within 1e-9 of the mesh's extent: sorted by position, neighbours compared.
+    std::vector<std::uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+        const glm::dvec3 p = vertices[i], q = vertices[j];
+        return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
+    });
+    const double tolerance = 1e-9 * std::max(extent, 1e-300);
+    std::pair<std::uint32_t, std::uint32_t> duplicate{0, 0};  // the pair of the lowest index
+    for (std::size_t k = 0; k < n; ++k) {
+        for (std::size_t l = k + 1; l < n && vertices[order[l]].x - vertices[order[k]].x <= tolerance; ++l) {
+            const std::pair<std::uint32_t, std::uint32_t> pair = std::minmax(order[k], order[l]);
+            if (glm::length(vertices[order[l]] - vertices[order[k]]) <= tolerance &&
+                (duplicate.second == 0 || pair < duplicate)) {
+                duplicate = pair;
+            }
+        }
+    }
+    if (const auto [i, j] = duplicate; j != 0) {
+        return "vertices " + std::to_string(i) + " and " + std::to_string(j) + " (OBJ indices " + std::to_string(i + 1) +
+               " and " + std::to_string(j + 1) + ") are duplicates, both at " + show(vertices[i]) +
+               ": weld them (a seam of duplicate vertices leaves the cloth in pieces)";
+    }
+    std::uint32_t third = 0;
+    const std::vector<EdgeUse> edges = edge_uses(triangles, &third);
+    for (const EdgeUse& e : edges) {
+        const std::string edge = "edge (" + std::to_string(std::min(e.a, e.b)) + ", " + std::to_string(std::max(e.a, e.b)) + ")";
+        if (e.count > 2) {
+            return "non-manifold " + edge + " at " + vertex_name(std::min(e.a, e.b)) + ": it is in " +
+                   std::to_string(e.count) + " triangles (" + std::to_string(e.triangle[0]) + ", " +
+                   std::to_string(e.triangle[1]) + ", " + std::to_string(third) + ", ...); allowed: at most 2";
+        }
+        if (e.count == 2 && e.same_direction) {
+            return "triangles " + std::to_string(e.triangle[0]) + " and " + std::to_string(e.triangle[1]) + " run " + edge +
+                   " the same way: their faces are not oriented alike";
+        }
+    }
+    // A vertex where two sheets meet at a point: its triangles, joined across the edges at it, make more than
+    // one fan.
+    std::vector<std::uint32_t> first(n + 1, 0), around;
+    for (const auto& tri : triangles) {
+        for (std::uint32_t i : tri) ++first[i + 1];
+    }
+    for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    around.resize(first[n]);
+    {
+        std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+        for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+            for (std::uint32_t i : triangles[t]) around[fill[i]++] = t;
+        }
+    }
+    std::unordered_map<std::uint64_t, std::uint32_t> edge_of;
+    edge_of.reserve(edges.size());
+    for (std::uint32_t e = 0; e < edges.size(); ++e) edge_of.emplace(edge_key(edges[e].a, edges[e].b), e);
+    std::vector<std::uint32_t> parent;
+    for (std::uint32_t v = 0; v < n; ++v) {
+        const std::uint32_t begin = first[v], count = first[v + 1] - first[v];
+        if (count < 2) continue;
+        parent.resize(count);
+        std::iota(parent.begin(), parent.end(), 0u);
+        auto find = [&](std::uint32_t i) {
+            while (parent[i] != i) i = parent[i] = parent[parent[i]];
+            return i;
+        };
+        auto local = [&](std::uint32_t t) {
+            return static_cast<std::uint32_t>(std::find(around.begin() + begin, around.begin() + begin + count, t) -
+                                              (around.begin() + begin));
+        };
+        for (std::uint32_t k = 0; k < count; ++k) {
+            for (std::uint32_t w : triangles[around[begin + k]]) {
+                if (w == v) continue;
+                const EdgeUse& e = edges[edge_of.at(edge_key(v, w))];
+                if (e.count == 2) parent[find(local(e.triangle[0]))] = find(local(e.triangle[1]));
+            }
+        }
+        std::uint32_t fans = 0;
+        for (std::uint32_t k = 0; k < count; ++k) fans += find(k) == k;
+        if (fans > 1) {
+            return "non-manifold " + vertex_name(v) + ": " + std::to_string(fans) +
+                   " sheets of triangles meet there at a point only";
+        }
+    }
+    return "";
+}
+
+std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const Triangles& triangles,
+                                     glm::dvec3 u_axis, glm::dvec2 stretch) {
+    const glm::dvec3 u = glm::normalize(u_axis);
+    auto area_of = [&](std::uint32_t tri) {
+        const auto& c = triangles[tri];
+        return 0.5 * glm::length(glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]));
+    };
+    std::vector<Spring> springs;
+    for (const EdgeUse& e : edge_uses(triangles)) {
+        const glm::dvec3 d = rest[e.b] - rest[e.a];
+        const double length2 = glm::dot(d, d);
+        // van Gelder 1998: k_e = E sum_T A_T / |e|^2, with E = E_u cos^2 + E_v sin^2 of the edge's angle to u.
+        const double cu = std::clamp(glm::dot(d, u) * glm::dot(d, u) / length2, 0.0, 1.0);
+        const double area = area_of(e.triangle[0]) + (e.count == 2 ? area_of(e.triangle[1]) : 0.0);
+        const double k = area / length2 * (stretch.x * cu + stretch.y * (1.0 - cu));
+        // The rest length in the spring kernels' arithmetic, as the grid's (cloth_builder.cpp); k = E_u w.
+        springs.push_back({e.a, e.b, glm::length(glm::vec3(d)), SpringKind::Structural, Axis::U,
+                           static_cast<float>(k / stretch.x)});
+    }
+    return springs;
+}
+
+std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest, const Triangles& triangles) {
+    std::vector<double> area(rest.size(), 0.0);
+    for (const auto& t : triangles) {
+        const double third = glm::length(glm::cross(rest[t[1]] - rest[t[0]], rest[t[2]] - rest[t[0]])) / 6.0;
+        for (std::uint32_t i : t) area[i] += third;
+    }
+    return area;
+}
+
+Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& triangles, glm::dvec3 u_axis,
+                       std::optional<glm::dvec2> stretch) {
+    const bool material = stretch.has_value();
+    const glm::dvec3 u = glm::normalize(u_axis);
+    Topology t;
+    t.mesh = true;
+    t.material_weights = material;
+    t.rows = 1;
+    t.cols = static_cast<int>(rest.size());
+    t.triangles = triangles;
+    auto area_of = [&](std::uint32_t tri) {
+        const auto& c = triangles[tri];
+        return 0.5 * glm::length(glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]));
+    };
+    // cos^2 of an edge's angle to u_axis.
+    auto along_u = [&](glm::dvec3 d) {
+        const double c = glm::dot(d, u);
+        return std::clamp(c * c / glm::dot(d, d), 0.0, 1.0);
+    };
+    const std::vector<EdgeUse> edges = edge_uses(triangles);
+    if (material) t.springs = membrane_springs(rest, triangles, u_axis, *stretch);
+    if (!material) {
+        // The per-spring form: springs.structural along u for an edge nearer u, along v otherwise.
+        for (const EdgeUse& e : edges) {
+            const glm::dvec3 d = rest[e.b] - rest[e.a];
+            const float rest_length = glm::length(glm::vec3(d));
+            t.springs.push_back({e.a, e.b, rest_length, SpringKind::Structural, along_u(d) >= 0.5 ? Axis::U : Axis::V, 1.0f});
+        }
+    }
+    // Hinges on interior edges (Bergou et al. 2006): triangle 0 is (x0, x1, x2), triangle 1 (x0, x1, x3).
+    for (const EdgeUse& e : edges) {
+        if (e.count != 2) continue;
+        auto opposite = [&](std::uint32_t tri) {
+            for (std::uint32_t i : triangles[tri]) {
+                if (i != e.a && i != e.b) return i;
+            }
+            return e.a;
+        };
+        Hinge h;
+        h.v = {e.a, e.b, opposite(e.triangle[0]), opposite(e.triangle[1])};
+        const glm::dvec3 x0 = rest[h.v[0]], x1 = rest[h.v[1]], x2 = rest[h.v[2]], x3 = rest[h.v[3]];
+        const double a0 = cotangent(x0, x1, x2), a1 = cotangent(x0, x1, x3);  // at x0
+        const double b0 = cotangent(x1, x0, x2), b1 = cotangent(x1, x0, x3);  // at x1
+        h.c = {float(b0 + b1), float(a0 + a1), float(-(a0 + b0)), float(-(a1 + b1))};
+        // B across the edge: an edge along u bends along v.
+        const double cu = along_u(x1 - x0);
+        const double w = material ? 1.0 / (area_of(e.triangle[0]) + area_of(e.triangle[1])) : 1.0;
+        h.weight_u = float(w * (1.0 - cu));
+        h.weight_v = float(w * cu);
+        t.hinges.push_back(h);
+    }
+    // Texture coordinates: the rest shape on u and on n x u, n the mean normal (by area).
+    glm::dvec3 normal(0.0);
+    for (const auto& c : triangles) normal += glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]);
+    glm::dvec3 across = glm::cross(normal, u);
+    if (!(glm::length(across) > 1e-9 * glm::length(normal))) {
+        across = glm::cross(u, std::abs(u.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0));
+    }
+    across = glm::normalize(across);
+    t.uv.reserve(rest.size());
+    for (const glm::dvec3& p : rest) t.uv.emplace_back(float(glm::dot(p - rest[0], u)), float(glm::dot(p - rest[0], across)));
+    t.count_by_kind();
+    return t;
+}
+
+std::string cloth_mesh_summary(const Topology& topology, std::size_t particles, double critical_substep) {
+    float shortest = std::numeric_limits<float>::infinity();
+    for (const Spring& s : topology.springs) shortest = std::min(shortest, s.rest_length);
+    // One spring per edge; a hinge per interior edge.
+    const std::size_t edges = topology.springs.size();
+    std::ostringstream out;
+    out.precision(3);
+    out << "mesh: " << particles << " vertices, " << edges << " edges (" << edges - std::min(edges, topology.hinges.size())
+        << " on the boundary), " << topology.triangles.size() << " triangles; shortest edge " << shortest << " m";
+    if (critical_substep > 0.0 && std::isfinite(critical_substep)) out << "; critical substep " << 1e3 * critical_substep << " ms";
+    return out.str();
+}
+
+}  // namespace clothsim

@@ -387,7 +387,7 @@ double strip_stretch(const Mesh& mesh, double length, double width, glm::vec2 st
 }  // namespace
 
 TEST_CASE("cloth mesh: a strip of irregular Delaunay triangles pulled along warp or weft carries material.stretch: "
-          "an isotropic fabric within 7%, an anisotropic one within 12%", "[cloth_mesh][material]") {
+          "an isotropic fabric within 7%, an anisotropic one within 12%", "[cloth_mesh][material][convergence]") {
     // van Gelder's springs are exact on equilateral triangles; a disordered network relaxes non-affinely and comes
     // out softer (4-6% at a jitter of 0.2 spacings), and cos^2 interpolation between warp and weft misses an
     // anisotropic fabric's axes by up to 10% (docs/MESH_CLOTH.md: the 3% is not met).
@@ -473,7 +473,7 @@ double mesh_cantilever_drop(const Mesh& mesh, double h, double length, double be
 }  // namespace
 
 TEST_CASE("cloth mesh: a clamped strip of irregular Delaunay triangles droops as the heavy elastica: within 3% at "
-          "large deflection, converging at small", "[cloth_mesh][material]") {
+          "large deflection, converging at small", "[cloth_mesh][material][convergence]") {
     // The strip of docs/MATERIAL.md (0.1 m x 0.025 m, density 0.15 kg/m^2, stretch 1000 N/m): at B = 1e-4 N m the
     // tip drops 0.078 m (large deflection), at 1e-2 N m 1.8 mm (w L^4 / 8B). On irregular triangles the clamp, the
     // vertices within one spacing of the end, holds less exactly than the grid's two columns: the stiff strip's
@@ -525,7 +525,7 @@ double largest_distance(const MassSpring& a, const MassSpring& b) {
 }  // namespace
 
 TEST_CASE("cloth mesh: the hanging cloth given as an OBJ of its own grid hangs like the grid cloth, within half a "
-          "spacing once settled, with Verlet and XPBD", "[cloth_mesh]") {
+          "spacing once settled, with Verlet and XPBD", "[cloth_mesh][settled]") {
     // The mesh model differs from the grid's: one diagonal per cell instead of two, van Gelder's springs, hinges
     // instead of bends. `hanging` swings for seconds at its damping of 0.2/s and its folds are chaotic there (a
     // bending stiffness 1e-4 higher moves the grid cloth by 1.7-5 spacings at 1-3 s: docs/MESH_CLOTH.md), so the

@@ -1,10 +1,14 @@
-// Fuzz target: the OBJ reader of mesh colliders. Any bytes go to parse_mesh_text(); SceneError naming the
-// source is the only allowed failure. An accepted mesh must answer every query a collider asks (nearest by the
-// tree and by a contact grid alike, a crossing, a box test, the winding number) with finite numbers, at
-// points around and inside its box. Built as the other targets (tests/fuzz/CMakeLists.txt).
+// Fuzz target: the OBJ reader of mesh colliders and cloth meshes. Any bytes go to parse_mesh_text(); SceneError
+// naming the source is the only allowed failure. An accepted mesh must answer every query a collider asks
+// (nearest by the tree and by a contact grid alike, a crossing, a box test, the winding number) with finite
+// numbers, at points around and inside its box; and, when cloth_mesh_problem() finds nothing wrong with it as a
+// cloth, it must build into a cloth whose every spring weight, hinge weight and mass is finite and positive.
+// Built as the other targets (tests/fuzz/CMakeLists.txt).
 #include "fuzz_support.hpp"
 
+#include "clothsim/cloth_mesh.hpp"
 #include "clothsim/mesh_file.hpp"
+#include "clothsim/scene.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -46,6 +50,34 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             fuzz::fail("a crossing outside the path");
         }
         (void)mesh->may_touch(p - glm::dvec3(reach), p + glm::dvec3(reach));
+    }
+    // As a cloth: refused with a reason, or built with finite, positive elements.
+    if (!cloth_mesh_problem(mesh->vertices(), mesh->triangles()).empty()) return 0;
+    Scene scene;
+    scene.cloth.mesh = "fuzz.obj";
+    scene.cloth.mesh_data = mesh;
+    scene.pins.preset = PinPreset::None;
+    scene.material.enabled = true;
+    MassSpring sim = [&] {
+        try {
+            return build_simulation(scene);
+        } catch (const SceneError& e) {
+            fuzz::fail("a mesh that passed the cloth checks did not build", e.what());
+        }
+    }();
+    for (const Spring& spring : sim.topology().springs) {
+        if (!(std::isfinite(spring.weight) && spring.weight >= 0.0f && spring.rest_length > 0.0f)) {
+            fuzz::fail("a cloth mesh's spring has a weight or rest length that is not finite and positive");
+        }
+    }
+    for (const Hinge& hinge : sim.topology().hinges) {
+        for (float c : hinge.c) {
+            if (!std::isfinite(c)) fuzz::fail("a cloth mesh's hinge has a weight that is not finite");
+        }
+        if (!(std::isfinite(hinge.weight_u) && std::isfinite(hinge.weight_v))) fuzz::fail("a hinge's stiffness is not finite");
+    }
+    for (float m : sim.state().mass) {
+        if (!(std::isfinite(m) && m > 0.0f)) fuzz::fail("a cloth mesh's particle has a mass that is not finite and positive");
     }
     return 0;
 }

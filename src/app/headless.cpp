@@ -284,12 +284,13 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         solver["residual"] = finite_or_null(sim.last_solver_residual());
     }
     out["solver"] = solver;
-    // A disc on the cylinder is a Cusick drape test (drape.hpp): its coefficient and folds.
+    // A disc (a grid's, or a mesh cloth) on the cylinder is a Cusick drape test (drape.hpp): its coefficient and
+    // folds.
     const CylinderCollider* support = nullptr;
     for (const Collider& c : sim.settings().colliders.shapes) {
         if (!support && c.enabled) support = std::get_if<CylinderCollider>(&c.shape);
     }
-    if (scene.cloth.shape == ClothShape::Disc && support) {
+    if ((scene.cloth.shape == ClothShape::Disc || scene.cloth.is_mesh()) && support) {
         const DrapeFigures drape = measure_drape(sim, glm::dvec3(support->center), support->radius);
         out["drape_coefficient"] = finite_or_null(drape.drape_coefficient);
         out["folds"] = drape.folds;

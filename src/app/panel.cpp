@@ -419,8 +419,8 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
         }
         if (app.sim.topology().mesh) {
             // Two lines, as the grid's below, so nothing moves between scenes.
-            ImGui::TextDisabled("mesh: van Gelder springs on the edges, Bergou hinges across them");
-            ImGui::TextDisabled("shear follows stretch on a mesh (3/8 of it): shear has no effect");
+            ImGui::TextDisabled("mesh: van Gelder springs, Bergou hinges");
+            ImGui::TextDisabled("on a mesh, shear is 3/8 of stretch (i)");
             if (ImGui::IsItemHovered()) {
                 ImGui::SetTooltip("Springs on triangles are a central-force lattice: its shear stiffness is 3/8 of\n"
                                   "its tensile stiffness (the Cauchy relation). docs/MESH_CLOTH.md");

@@ -9,6 +9,7 @@
 #include "integrators/grid_xpbd.hpp"
 #include "integrators/integrator_step.hpp"
 #include "integrators/integrators.hpp"
+#include "integrators/work_team.hpp"
 #include "collision/penalty_contact.hpp"
 #include "integrators/projective.hpp"
 #include "integrators/verlet.hpp"
@@ -368,7 +369,14 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
     force_.resize(state_.size());
     if (plan_.any_springs()) {
         StageTimer timer(profile, Stage::Springs);
-        accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
+        // A mesh cloth's fast path: the same sums on the team (element_gather.hpp); the textbook method is the
+        // list, on one thread, the oracle.
+        if (in_->gather && settings_.solver.method == SolverMethod::Fast) {
+            const int threads = settings_.solver.threads > 0 ? settings_.solver.threads : WorkTeam::cores();
+            gather_spring_forces(topology_, *in_->gather, state_.position, settings_.springs, force_, threads);
+        } else {
+            accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
+        }
     }
     if (plan_.external_forces()) add_external_forces(state_, force_, external_, profile);
     if (in_->grab) force_.add(in_->grab->particle, grab_force(state_));
@@ -477,6 +485,8 @@ void MassSpring::topology_changed(std::size_t removed) {
 // The fast solver's layout of the current topology, or none when it is no grid.
 void MassSpring::build_fast_solver() {
     in_->fast.reset();
+    in_->gather.reset();
+    if (topology_.mesh) in_->gather = ElementGather::for_topology(topology_);
     if (auto solver = FastSolver::for_topology(topology_)) {
         in_->fast = std::move(*solver);
     }

@@ -10,6 +10,7 @@
 #include "collision/self_collision.hpp"
 #include "integrators/fast_solver.hpp"
 #include "integrators/integrator_step.hpp"
+#include "model/element_gather.hpp"
 #include "model/grab_spring.hpp"
 #include "model/tethers.hpp"
 #include "simulation/sleep_monitor.hpp"
@@ -28,6 +29,7 @@ struct MassSpring::Internals {
     };
 
     std::optional<FastSolver> fast;    // when the topology is a grid
+    std::optional<ElementGather> gather;  // when it is a mesh cloth: its springs and hinges on the team
     IntegratorCaches iterative;        // projective's factorisation and BDF2 history, XPBD's multipliers and grid form
     CollisionBlocks blocks;            // particle blocks and their boxes for the collision broad phase
     MotionBounds motion_bounds;        // the fast solver's bounds of this substep's motion (sweep_takes_motion_bounds)

@@ -3,7 +3,11 @@
 
 #include "clothsim/scene.hpp"
 
+#include <glm/geometric.hpp>
+
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <initializer_list>
 #include <stdexcept>
@@ -11,6 +15,49 @@
 #include <string_view>
 
 namespace clothsim::test {
+
+// The heavy elastica: B theta'' = -q (L - s) cos(theta), theta(0) = 0, theta'(L) = 0, q = density g (a clamped
+// strip under its own weight). Solved by shooting on theta'(0) (bisection; the residual theta'(L) grows with it)
+// with RK4 in s; returns the tip drop, the integral of sin(theta) ds.
+inline double elastica_tip_drop(double length, double bending, double q) {
+    const int n = 4000;
+    const double ds = length / n;
+    auto shoot = [&](double kappa0, double* drop) {
+        double theta = 0.0, kappa = kappa0, y = 0.0;
+        auto f = [&](double s, double th, double ka) {
+            return std::array<double, 3>{ka, -q / bending * (length - s) * std::cos(th), std::sin(th)};
+        };
+        for (int i = 0; i < n; ++i) {
+            const double s = i * ds;
+            const auto k1 = f(s, theta, kappa);
+            const auto k2 = f(s + ds / 2, theta + ds / 2 * k1[0], kappa + ds / 2 * k1[1]);
+            const auto k3 = f(s + ds / 2, theta + ds / 2 * k2[0], kappa + ds / 2 * k2[1]);
+            const auto k4 = f(s + ds, theta + ds * k3[0], kappa + ds * k3[1]);
+            theta += ds / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
+            kappa += ds / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
+            y += ds / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
+        }
+        if (drop) *drop = y;
+        return kappa;  // theta'(L)
+    };
+    double lo = 0.0, hi = q * length * length / bending;  // theta'(L) < 0 at lo, > 0 at the linear moment bound
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (shoot(mid, nullptr) < 0.0 ? lo : hi) = mid;
+    }
+    double drop = 0.0;
+    shoot(0.5 * (lo + hi), &drop);
+    return drop;
+}
+
+// The largest distance between the same particle of two cloths (m).
+inline double largest_distance(const MassSpring& a, const MassSpring& b) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.particle_count(); ++i) {
+        worst = std::max(worst, glm::length(a.state().position.get(i) - b.state().position.get(i)));
+    }
+    return worst;
+}
 
 // Free particles of one mass at the given positions, at rest: every state array sized, nothing pinned.
 inline State free_particles(std::initializer_list<glm::vec3> positions, float mass) {

@@ -219,8 +219,8 @@ TEST_CASE("user session: a scene of another size opened while paused is drawn as
         REQUIRE(opened.width == kWidth);
         CHECK(differing_pixels(opened, expected, kViewRect, 30) == 0);
     };
-    SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its second item)") {
-        open_curtain("session_open_combo", "click 110 59\nclick 40 101\n");
+    SECTION("picked in the bundled-scene combo (the combo at the top of the panel, curtain its third item)") {
+        open_curtain("session_open_combo", "click 110 59\nclick 40 118\n");
     }
     SECTION("typed into the built-in file browser's name field after Open file...") {
         open_curtain("session_open_file", "click 50 82\nsettle\ntype '" + scene_path("curtain") + "'\nkey Return\n");
@@ -362,7 +362,7 @@ TEST_CASE("user session: labels follow the scene, and two F12 presses in a secon
     const TempDir dir("session_labels");
     const RunResult r = run_user_session(dir, {"--scene", "flag", "--paused"},
                                          "echo \"title before: $(xdotool getwindowname $wid)\"\n"
-                                         "click 110 59\nclick 40 101\nat 900 400\nsettle\n"  // curtain, after chair-drape
+                                         "click 110 59\nclick 40 118\nat 900 400\nsettle\n"  // curtain, after cape and chair-drape
                                          "echo \"title after: $(xdotool getwindowname $wid)\"\n"
                                          // Each press waits for its file (up to 20 s under load); in most runs both land in one second.
                                          "xdotool keydown F12; sleep 0.1; xdotool keyup F12\n"

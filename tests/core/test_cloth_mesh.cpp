@@ -411,39 +411,6 @@ TEST_CASE("cloth mesh: a strip of irregular Delaunay triangles pulled along warp
 
 namespace {
 
-// The heavy elastica: B theta'' = -q (L - s) cos(theta), theta(0) = 0, theta'(L) = 0 (test_material.cpp has the
-// same shooting solution for the grid): the tip drop.
-double elastica_drop(double length, double bending, double q) {
-    const int n = 4000;
-    const double ds = length / n;
-    auto shoot = [&](double kappa0, double* drop) {
-        double theta = 0.0, kappa = kappa0, y = 0.0;
-        auto f = [&](double s, double th, double ka) {
-            return std::array<double, 3>{ka, -q / bending * (length - s) * std::cos(th), std::sin(th)};
-        };
-        for (int i = 0; i < n; ++i) {
-            const double s = i * ds;
-            const auto k1 = f(s, theta, kappa);
-            const auto k2 = f(s + ds / 2, theta + ds / 2 * k1[0], kappa + ds / 2 * k1[1]);
-            const auto k3 = f(s + ds / 2, theta + ds / 2 * k2[0], kappa + ds / 2 * k2[1]);
-            const auto k4 = f(s + ds, theta + ds * k3[0], kappa + ds * k3[1]);
-            theta += ds / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
-            kappa += ds / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
-            y += ds / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
-        }
-        if (drop) *drop = y;
-        return kappa;
-    };
-    double lo = 0.0, hi = q * length * length / bending;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (shoot(mid, nullptr) < 0.0 ? lo : hi) = mid;
-    }
-    double drop = 0.0;
-    shoot(0.5 * (lo + hi), &drop);
-    return drop;
-}
-
 // A strip of `mesh` (x from 0, along x) clamped by its vertices within one spacing h of x = 0, the clamp line at
 // h / 2 (where a two-column clamp holds, as on the grid), settled under gravity with damping at critical for
 // its first mode; the mean drop of its last vertices.
@@ -480,7 +447,7 @@ TEST_CASE("cloth mesh: a clamped strip of irregular Delaunay triangles droops as
     // error falls from 15-20% at 17 vertices along to 5-6% at 33 (docs/MESH_CLOTH.md).
     const double length = 0.1, width = 0.025;
     for (double bending : {1e-4, 1e-2}) {
-        const double exact = elastica_drop(length, bending, 0.15 * 9.81);
+        const double exact = test::elastica_tip_drop(length, bending, 0.15 * 9.81);
         std::array<double, 2> worst{};
         for (int along : {17, 33}) {
             const double h = length / (along - 1.5);
@@ -514,13 +481,6 @@ std::filesystem::path write_grid_obj(const Scene& scene, const std::filesystem::
     return path;
 }
 
-double largest_distance(const MassSpring& a, const MassSpring& b) {
-    double worst = 0.0;
-    for (std::size_t i = 0; i < a.particle_count(); ++i) {
-        worst = std::max(worst, glm::length(a.state().position.get(i) - b.state().position.get(i)));
-    }
-    return worst;
-}
 
 }  // namespace
 
@@ -548,10 +508,10 @@ TEST_CASE("cloth mesh: the hanging cloth given as an OBJ of its own grid hangs l
         a.run_steps(180);
         b.run_steps(180);
         const double spacing = 1.0 / 31.0;
-        INFO(integrator << ": the largest distance after 3 s is " << largest_distance(a, b) / spacing << " spacings");
+        INFO(integrator << ": the largest distance after 3 s is " << test::largest_distance(a, b) / spacing << " spacings");
         CHECK(b.all_finite());
         CHECK(!b.last_step_fast());
-        CHECK(largest_distance(a, b) < 0.5 * spacing);
+        CHECK(test::largest_distance(a, b) < 0.5 * spacing);
     }
 }
 

@@ -14,40 +14,6 @@ using namespace clothsim;
 
 namespace {
 
-// The heavy elastica: B theta'' = -q (L - s) cos(theta), theta(0) = 0, theta'(L) = 0, q = density g. Solved by
-// shooting on theta'(0) (bisection; the residual theta'(L) grows with it) with RK4 in s; returns the tip drop
-// integral of sin(theta) ds.
-double elastica_tip_drop(double length, double bending, double q) {
-    const int n = 4000;
-    const double ds = length / n;
-    auto shoot = [&](double kappa0, double* drop) {
-        double theta = 0.0, kappa = kappa0, y = 0.0;
-        auto f = [&](double s, double th, double ka) {
-            return std::array<double, 3>{ka, -q / bending * (length - s) * std::cos(th), std::sin(th)};
-        };
-        for (int i = 0; i < n; ++i) {
-            const double s = i * ds;
-            const auto k1 = f(s, theta, kappa);
-            const auto k2 = f(s + ds / 2, theta + ds / 2 * k1[0], kappa + ds / 2 * k1[1]);
-            const auto k3 = f(s + ds / 2, theta + ds / 2 * k2[0], kappa + ds / 2 * k2[1]);
-            const auto k4 = f(s + ds, theta + ds * k3[0], kappa + ds * k3[1]);
-            theta += ds / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
-            kappa += ds / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
-            y += ds / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
-        }
-        if (drop) *drop = y;
-        return kappa;  // theta'(L)
-    };
-    double lo = 0.0, hi = q * length * length / bending;  // theta'(L) < 0 at lo, > 0 at the linear moment bound
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (shoot(mid, nullptr) < 0.0 ? lo : hi) = mid;
-    }
-    double drop = 0.0;
-    shoot(0.5 * (lo + hi), &drop);
-    return drop;
-}
-
 // A strip `length` x `width` lying flat along x in the horizontal plane, clamped at x = 0 by its first two
 // columns of particles, settled under gravity; its tip's mean drop (m).
 // The clamp line lies `clamp_back` spacings behind column 1: halfway between the two pinned columns (0.5) is
@@ -98,7 +64,7 @@ TEST_CASE("material: a clamped strip's tip drop matches the heavy elastica withi
     // The issue's strip: 0.1 m x 0.025 m, density 0.15 kg/m^2, B = 1e-4 N m, stretch 1000 N/m (strain 1.5e-4 at
     // this load: inextensible).
     const double q = 0.15 * 9.81;
-    const double exact = elastica_tip_drop(0.1, 1e-4, q);
+    const double exact = test::elastica_tip_drop(0.1, 1e-4, q);
     // Large deflection: the linear formula q L^4 / 8B would say 0.184 m, more than the strip's length.
     REQUIRE(exact == Approx(0.0783).epsilon(0.01));
     const double coarse = cantilever_drop(33, 0.1, 0.025, 1e-4, 0.5, false);
@@ -112,7 +78,7 @@ TEST_CASE("material: a clamped strip's tip drop matches the heavy elastica withi
 TEST_CASE("material: a stiff clamped strip's tip drop matches the small-deflection w L^4 / 8B", "[material][convergence]") {
     const double q = 0.15 * 9.81, b = 1e-2;
     const double linear = q * std::pow(0.1, 4) / (8.0 * b);
-    REQUIRE(elastica_tip_drop(0.1, b, q) == Approx(linear).epsilon(1e-3));  // the elastica agrees here
+    REQUIRE(test::elastica_tip_drop(0.1, b, q) == Approx(linear).epsilon(1e-3));  // the elastica agrees here
     const double coarse = cantilever_drop(33, 0.1, 0.025, b, 0.5, false);
     const double fine = cantilever_drop(65, 0.1, 0.025, b, 0.5, false);
     INFO("w L^4 / 8B = " << linear << " m; 33 particles " << coarse << ", 65 particles " << fine);
@@ -126,7 +92,7 @@ TEST_CASE("material: a stiff clamped strip's tip drop matches the small-deflecti
 TEST_CASE("material study: bends and skip-one springs against the elastica", "[material][.study]") {
     const double q = 0.15 * 9.81;
     for (double b : {1e-4, 1e-2}) {
-        const double exact = elastica_tip_drop(0.1, b, q);
+        const double exact = test::elastica_tip_drop(0.1, b, q);
         std::printf("B = %g N m: elastica tip drop %.6g m (small-deflection formula %.6g)\n", b, exact,
                     q * 1e-4 / (8 * b));
         for (int n : {17, 33, 65}) {

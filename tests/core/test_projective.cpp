@@ -28,14 +28,6 @@ Scene stiff_hanging(int iterations) {
     return s;
 }
 
-double largest_distance(const MassSpring& a, const MassSpring& b) {
-    double worst = 0.0;
-    for (std::size_t i = 0; i < a.particle_count(); ++i) {
-        worst = std::max(worst, glm::length(a.state().position.get(i) - b.state().position.get(i)));
-    }
-    return worst;
-}
-
 }  // namespace
 
 TEST_CASE("projective: more iterations lower the residual and approach the converged step", "[projective]") {
@@ -48,7 +40,7 @@ TEST_CASE("projective: more iterations lower the residual and approach the conve
     for (int iterations : {1, 4, 16, 64}) {
         MassSpring sim = build_simulation(stiff_hanging(iterations));
         sim.run_steps(20);
-        const double distance = largest_distance(sim, converged);
+        const double distance = test::largest_distance(sim, converged);
         INFO(iterations << " iterations: residual " << sim.last_solver_residual() << ", " << distance
                         << " m from the converged run");
         CHECK(sim.last_solver_iterations() == iterations);
@@ -127,5 +119,5 @@ TEST_CASE("projective: a damped cloth settles where Verlet settles", "[projectiv
     INFO("kinetic energy: projective " << projective.energy().kinetic << " J, verlet " << verlet.energy().kinetic);
     CHECK(projective.energy().kinetic < 1e-8);
     CHECK(verlet.energy().kinetic < 1e-8);
-    CHECK(largest_distance(projective, verlet) < 1e-4);  // 0.1 mm on a 0.6 m cloth
+    CHECK(test::largest_distance(projective, verlet) < 1e-4);  // 0.1 mm on a 0.6 m cloth
 }

@@ -310,6 +310,14 @@ TEST_CASE("cloth mesh: hinges store the plate's 0.5 B kappa^2 per area on a cyli
     }
 }
 
+TEST_CASE("cloth mesh: a mesh too small for its vertices to carry a mass is refused, naming the vertex", "[cloth_mesh]") {
+    Mesh tiny = rectangle_mesh(3, 1.0, 1.0, 0.0, 1);
+    for (glm::dvec3& p : tiny.vertices) p *= 1e-22;  // areas of 1e-45 m^2: no float mass at 0.15 kg/m^2
+    Scene s = mesh_scene(tiny, glm::vec2(1000.0f), 1e-5f);
+    CHECK_THROWS_WITH(build_simulation(s), Catch::Contains("cloth.mesh = \"generated.obj\": vertex 0 carries") &&
+                                               Catch::Contains("too little for a mass"));
+}
+
 TEST_CASE("cloth mesh: masses are density x a third of each triangle; the cloth weighs density x area", "[cloth_mesh]") {
     const Mesh m = rectangle_mesh(9, 0.4, 0.1, 0.2, 5);
     Scene s = mesh_scene(m, glm::vec2(1000.0f), 1e-5f);

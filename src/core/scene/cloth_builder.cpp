@@ -334,6 +334,12 @@ MassSpring build_mesh_simulation(const Scene& scene) {
     state.pinned.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
         state.mass[i] = static_cast<float>(per_area * area[i]);
+        // A mesh so small (or so light) that a vertex's share rounds to no mass in float cannot move.
+        if (!(state.mass[i] > 0.0f && std::isfinite(1.0f / state.mass[i]))) {
+            throw SceneError("cloth.mesh = \"" + cloth.mesh + "\": vertex " + std::to_string(i) + " carries " +
+                             std::to_string(area[i]) + " m^2 of cloth, too little for a mass; allowed: a mesh whose "
+                             "triangles are larger (cloth.mesh_scale scales it)");
+        }
         state.inverse_mass[i] = 1.0f / state.mass[i];
     }
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {

@@ -70,6 +70,12 @@ std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest,
 // vertices (no grid preset: a mesh has no rows). Throws SceneError.
 void validate_mesh_cloth(const Scene& scene);
 
+// Each particle's mass (kg) for a mesh cloth whose vertices carry `area` (vertex_areas): cloth.mass shared in
+// proportion to area (the material form's cloth.mass is density x area: derive_springs). What the builder and a
+// live change of the fabric (apply_fabric) both put on the cloth. Throws SceneError naming the vertex when one
+// carries too little area for a mass in float.
+std::vector<float> mesh_cloth_masses(const ClothSettings& cloth, const std::vector<double>& area);
+
 // One line on a mesh cloth for --print-scene and the panel: "mesh: 1024 vertices, 2945 edges (124 on the
 // boundary), 1922 triangles; shortest edge 0.0323 m; critical substep 0.161 ms" (the explicit stability limit,
 // stability.hpp; 0 or infinity leaves it out). From the running topology: after a tear, what is left.

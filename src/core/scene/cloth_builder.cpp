@@ -267,12 +267,7 @@ void apply_fabric(MassSpring& sim, const Scene& scene) {
             sim.set_spring_weights(membrane_springs(rest, derived.cloth.mesh_data->triangles(), glm::dvec3(derived.cloth.u_axis),
                                                     glm::dvec2(derived.material.stretch)));
         }
-        const std::vector<double> area = vertex_areas(rest, derived.cloth.mesh_data->triangles());
-        double total = 0.0;
-        for (double a : area) total += a;
-        std::vector<float> mass(area.size());
-        for (std::size_t i = 0; i < area.size(); ++i) mass[i] = static_cast<float>(double(derived.cloth.mass) * area[i] / total);
-        sim.set_masses(mass);
+        sim.set_masses(mesh_cloth_masses(derived.cloth, vertex_areas(rest, derived.cloth.mesh_data->triangles())));
         sim.apply(settings);
         return;
     }
@@ -324,24 +319,10 @@ MassSpring build_mesh_simulation(const Scene& scene) {
     Scene derived = scene;
     derive_springs(derived);
     const std::vector<double> area = vertex_areas(rest, triangles);
-    double total_area = 0.0;
-    for (double a : area) total_area += a;
-    // The material's density, or cloth.mass in proportion to area (the same thing: derive_springs sets cloth.mass
-    // to density x area).
-    const double per_area = double(derived.cloth.mass) / total_area;
-    state.mass.resize(n);
+    state.mass = mesh_cloth_masses(derived.cloth, area);
     state.inverse_mass.resize(n);
     state.pinned.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-        state.mass[i] = static_cast<float>(per_area * area[i]);
-        // A mesh so small (or so light) that a vertex's share rounds to no mass in float cannot move.
-        if (!(state.mass[i] > 0.0f && std::isfinite(1.0f / state.mass[i]))) {
-            throw SceneError("cloth.mesh = \"" + cloth.mesh + "\": vertex " + std::to_string(i) + " carries " +
-                             std::to_string(area[i]) + " m^2 of cloth, too little for a mass; allowed: a mesh whose "
-                             "triangles are larger (cloth.mesh_scale scales it)");
-        }
-        state.inverse_mass[i] = 1.0f / state.mass[i];
-    }
+    for (std::size_t i = 0; i < n; ++i) state.inverse_mass[i] = 1.0f / state.mass[i];
     for (std::size_t i : pinned_particles(cloth, scene.pins)) {
         state.pinned[i] = kPinned;
         state.inverse_mass[i] = 0.0f;

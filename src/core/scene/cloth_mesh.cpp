@@ -57,6 +57,10 @@ std::vector<EdgeUse> edge_uses(const Triangles& triangles, std::uint32_t* third_
     return edges;
 }
 
+double triangle_area(const std::vector<glm::dvec3>& rest, const std::array<std::uint32_t, 3>& t) {
+    return 0.5 * glm::length(glm::cross(rest[t[1]] - rest[t[0]], rest[t[2]] - rest[t[0]]));
+}
+
 // 0-based, as pins count vertices, with the OBJ file's 1-based index.
 std::string vertex_name(std::size_t i) { return "vertex " + std::to_string(i) + " (OBJ index " + std::to_string(i + 1) + ")"; }
 
@@ -208,17 +212,13 @@ std::string cloth_mesh_problem(const std::vector<glm::dvec3>& vertices, const Tr
 std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const Triangles& triangles,
                                      glm::dvec3 u_axis, glm::dvec2 stretch) {
     const glm::dvec3 u = glm::normalize(u_axis);
-    auto area_of = [&](std::uint32_t tri) {
-        const auto& c = triangles[tri];
-        return 0.5 * glm::length(glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]));
-    };
     std::vector<Spring> springs;
     for (const EdgeUse& e : edge_uses(triangles)) {
         const glm::dvec3 d = rest[e.b] - rest[e.a];
         const double length2 = glm::dot(d, d);
         // van Gelder 1998: k_e = E sum_T A_T / |e|^2, with E = E_u cos^2 + E_v sin^2 of the edge's angle to u.
         const double cu = std::clamp(glm::dot(d, u) * glm::dot(d, u) / length2, 0.0, 1.0);
-        const double area = area_of(e.triangle[0]) + (e.count == 2 ? area_of(e.triangle[1]) : 0.0);
+        const double area = triangle_area(rest, triangles[e.triangle[0]]) + (e.count == 2 ? triangle_area(rest, triangles[e.triangle[1]]) : 0.0);
         const double k = area / length2 * (stretch.x * cu + stretch.y * (1.0 - cu));
         // The rest length in the spring kernels' arithmetic, as the grid's (cloth_builder.cpp); k = E_u w.
         springs.push_back({e.a, e.b, glm::length(glm::vec3(d)), SpringKind::Structural, Axis::U,
@@ -230,6 +230,7 @@ std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const 
 std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest, const Triangles& triangles) {
     std::vector<double> area(rest.size(), 0.0);
     for (const auto& t : triangles) {
+        // Twice the area over 6 (not triangle_area / 3): the masses' rounding as recorded (test_stepper's hashes).
         const double third = glm::length(glm::cross(rest[t[1]] - rest[t[0]], rest[t[2]] - rest[t[0]])) / 6.0;
         for (std::uint32_t i : t) area[i] += third;
     }
@@ -246,10 +247,6 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
     t.rows = 1;
     t.cols = static_cast<int>(rest.size());
     t.triangles = triangles;
-    auto area_of = [&](std::uint32_t tri) {
-        const auto& c = triangles[tri];
-        return 0.5 * glm::length(glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]));
-    };
     // cos^2 of an edge's angle to u_axis.
     auto along_u = [&](glm::dvec3 d) {
         const double c = glm::dot(d, u);
@@ -282,7 +279,7 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
         h.c = {float(b0 + b1), float(a0 + a1), float(-(a0 + b0)), float(-(a1 + b1))};
         // B across the edge: an edge along u bends along v.
         const double cu = along_u(x1 - x0);
-        const double w = material ? 1.0 / (area_of(e.triangle[0]) + area_of(e.triangle[1])) : 1.0;
+        const double w = material ? 1.0 / (triangle_area(rest, triangles[e.triangle[0]]) + triangle_area(rest, triangles[e.triangle[1]])) : 1.0;
         h.weight_u = float(w * (1.0 - cu));
         h.weight_v = float(w * cu);
         t.hinges.push_back(h);
@@ -299,6 +296,23 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
     for (const glm::dvec3& p : rest) t.uv.emplace_back(float(glm::dot(p - rest[0], u)), float(glm::dot(p - rest[0], across)));
     t.count_by_kind();
     return t;
+}
+
+std::vector<float> mesh_cloth_masses(const ClothSettings& cloth, const std::vector<double>& area) {
+    double total = 0.0;
+    for (double a : area) total += a;
+    const double per_area = double(cloth.mass) / total;
+    std::vector<float> mass(area.size());
+    for (std::size_t i = 0; i < area.size(); ++i) {
+        mass[i] = static_cast<float>(per_area * area[i]);
+        // A mesh so small (or so light) that a vertex's share rounds to no mass in float cannot move.
+        if (!(mass[i] > 0.0f && std::isfinite(1.0f / mass[i]))) {
+            throw SceneError("cloth.mesh = \"" + cloth.mesh + "\": vertex " + std::to_string(i) + " carries " +
+                             std::to_string(area[i]) + " m^2 of cloth, too little for a mass; allowed: a mesh whose "
+                             "triangles are larger (cloth.mesh_scale scales it)");
+        }
+    }
+    return mass;
 }
 
 std::string cloth_mesh_summary(const Topology& topology, std::size_t particles, double critical_substep) {

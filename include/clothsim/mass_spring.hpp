@@ -51,6 +51,7 @@ struct Energy {
 
 struct CollisionBlocks;
 struct MotionBounds;
+enum class BlockBounds;
 
 class MassSpring {
 public:
@@ -243,11 +244,18 @@ private:
     bool sweep_takes_motion_bounds() const;
     // `known`: the bounds of the motion as it is now, or null. Returns whether it moved anything.
     bool collide_self(StepProfile* profile, const MotionBounds* known, bool uncounted);
-    // Returns how many tethers were at their limit.
-    std::size_t apply_tethers();
+    // Returns how many tethers were at their limit. With `boxes`, each band of the fast solver also boxes its
+    // rows for the broad phase, bounded as `*boxes` says, right after projecting them (one job, not two).
+    std::size_t apply_tethers(const BlockBounds* boxes = nullptr);
+    // Whether the collision blocks are boxed on the fast solver's bands after the stages that follow the solver
+    // moved particles (else the collision stage boxes them).
+    bool boxes_on_team() const;
     // The collision blocks' boxes again after the stages that follow the solver moved particles; false when
-    // left to the collision stage.
-    bool box_blocks_on_team(StepProfile* profile);
+    // left to the collision stage. `made`: the bounds the boxes were already made with (by apply_tethers),
+    // kept when the bounds are still the same.
+    bool box_blocks_on_team(StepProfile* profile, const BlockBounds* made = nullptr);
+    // Boxes rows [begin, end) of the collision blocks (the fast solver's grid layout).
+    void box_rows(int begin, int end, BlockBounds bounds);
     // Each returns whether it moved a particle.
     bool limit_strain();
     bool limit_speed(double h);

@@ -163,7 +163,7 @@ TEST_CASE("broad_phase union_of is the box around its boxes, a NaN bound left ou
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> coord(-5.0f, 5.0f);
     std::uniform_int_distribution<int> pick(0, 19);
-    for (std::size_t n : {0u, 1u, 2u, 3u, 17u, 256u}) {
+    for (std::size_t n : {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 17u, 256u}) {
         std::vector<Box> boxes(n);
         for (Box& b : boxes) {
             const int kind = pick(rng);

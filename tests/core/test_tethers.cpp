@@ -143,6 +143,38 @@ TEST_CASE("tethers: on the fast solver's bands and threads the cloth is the text
     });
 }
 
+TEST_CASE("tethers: on the fast path the cloth swings into a sphere as on the textbook path, bit for bit, the "
+          "blocks boxed in the tethers' job, every kernel and thread count", "[tethers][fast_solver][broad_phase]") {
+    // With no limit stage between them, each band boxes its blocks right after projecting its tethers
+    // (MassSpring::apply_tethers); a tether at its limit widens the carried box, and when that turns the
+    // lowest-point boxes into whole ones the blocks are boxed again. A box that missed a particle, or lowest
+    // points kept while the sphere is within reach, would let the cloth through the sphere, which the
+    // textbook path (every block boxed by the collision stage, in one pass) does not.
+    test::with_every_kernel([] {
+        Scene s = hanging(40, 0.001f);
+        // In the path of the cloth swinging down from its pinned edge (z = -0.5, y = 1.6).
+        test::collider(s.settings.colliders, "sphere") = Collider{SphereCollider{{0.0f, 1.1f, -0.2f}, 0.15f}, 0.3f, true, {}};
+        s.settings.solver.method = SolverMethod::Textbook;
+        MassSpring textbook = build_simulation(s);
+        textbook.run_steps(60);
+        Scene open = s;
+        test::collider(open.settings.colliders, "sphere").enabled = false;
+        MassSpring missed = build_simulation(open);
+        missed.run_steps(60);
+        REQUIRE_FALSE(test::bit_identical(missed, textbook));  // the sphere is met
+        for (int threads : test::thread_counts({1, 2, 3})) {
+            s.settings.solver.threads = threads;
+            s.settings.solver.method = SolverMethod::Fast;
+            MassSpring fast = build_simulation(s);
+            REQUIRE(fast.plan().path == StepPath::FastVerlet);
+            REQUIRE(fast.plan().tethers);
+            fast.run_steps(60);
+            INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
+            CHECK(test::bit_identical(fast, textbook));
+        }
+    });
+}
+
 TEST_CASE("tethers: on the fast path the collision blocks' boxes after a substep bound the particles the tethers "
           "moved, every kernel and thread count", "[tethers][fast_solver][broad_phase]") {
     // The ground far below: the broad phase runs and no contact grows a box, so each box is exactly its

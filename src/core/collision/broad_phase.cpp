@@ -284,15 +284,26 @@ Box union_of(const Box* boxes, std::size_t n) {
     if (n == 0) return all;
     // Four floats from each bound (the fourth lane, the next float in memory, is ignored); the last box alone,
     // so no load reads past the array. MINPS(v, lo) returns lo when either is NaN: glm::min(lo, v)'s
-    // (v < lo ? v : lo).
-    __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-    for (std::size_t k = 0; k + 1 < n; ++k) {
-        lo = _mm_min_ps(_mm_loadu_ps(&boxes[k].lo.x), lo);
-        hi = _mm_max_ps(_mm_loadu_ps(&boxes[k].hi.x), hi);
+    // (v < lo ? v : lo), so no accumulator ever holds a NaN. Four accumulators each, so the loop waits on
+    // MINPS's latency once per four boxes, not once per box (the union runs every substep, over a
+    // thousand boxes at 128 x 128); min and max are exact, so the order does not change the result.
+    __m128 lo[4], hi[4];
+    for (int a = 0; a < 4; ++a) lo[a] = _mm_set1_ps(INFINITY), hi[a] = _mm_set1_ps(-INFINITY);
+    std::size_t k = 0;
+    for (; k + 4 < n; k += 4) {
+        for (int a = 0; a < 4; ++a) {
+            lo[a] = _mm_min_ps(_mm_loadu_ps(&boxes[k + a].lo.x), lo[a]);
+            hi[a] = _mm_max_ps(_mm_loadu_ps(&boxes[k + a].hi.x), hi[a]);
+        }
     }
+    for (; k + 1 < n; ++k) {
+        lo[0] = _mm_min_ps(_mm_loadu_ps(&boxes[k].lo.x), lo[0]);
+        hi[0] = _mm_max_ps(_mm_loadu_ps(&boxes[k].hi.x), hi[0]);
+    }
+    for (int a = 1; a < 4; ++a) lo[0] = _mm_min_ps(lo[a], lo[0]), hi[0] = _mm_max_ps(hi[a], hi[0]);
     alignas(16) float l[4], h[4];
-    _mm_store_ps(l, lo);
-    _mm_store_ps(h, hi);
+    _mm_store_ps(l, lo[0]);
+    _mm_store_ps(h, hi[0]);
     all.lo = glm::min(glm::vec3(l[0], l[1], l[2]), boxes[n - 1].lo);
     all.hi = glm::max(glm::vec3(h[0], h[1], h[2]), boxes[n - 1].hi);
     return all;

@@ -13,6 +13,7 @@
 
 #include <glm/vec2.hpp>
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -46,7 +47,11 @@ struct MaterialPreset {
     std::string_view note;  // the fabric measured and where, one line
 };
 std::span<const MaterialPreset> material_presets();
+// By name, or by a name it had (material_preset_alias_note).
 const MaterialPreset* find_material_preset(std::string_view name);
+// For a name a preset had ("silk"): the note that says which preset it loads and why; nothing otherwise. A
+// scene given an old name holds the preset's own name and this note in Scene::notes.
+std::optional<std::string> material_preset_alias_note(std::string_view name);
 
 // Grid spacing (m): along u_axis (between columns) and along v_axis (between rows).
 glm::dvec2 grid_spacing(const ClothSettings& cloth);

@@ -196,6 +196,9 @@ struct Scene {
     unsigned per_spring_fields = 0;
     PinSpec pins;
     SimulationSettings settings;
+    // What loading it had to say besides errors, one line each (an old preset name and the fabric it loads):
+    // the command line prints them, the app shows them.
+    std::vector<std::string> notes;
 };
 
 }  // namespace clothsim

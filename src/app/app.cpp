@@ -622,6 +622,7 @@ void apply_requests(AppState& app, Renderer& renderer, const Window& window, flo
             after_rebuild(app, renderer);
             reset_camera(app, aspect);
             app.say("loaded " + *requests.load);
+            for (const std::string& note : app.loaded.notes) app.say(note);
         }
     }
     if (requests.reset || requests.revert) {
@@ -1030,6 +1031,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
         app.panel_width = app.saved_settings.panel_width;
     }
     loaded_from(app, options.scene_source);
+    for (const std::string& note : scene.notes) app.say(note);  // the command line has printed them
     if (!options.record.empty()) app.recording = Recording{std::filesystem::absolute(options.record), 0, {}};
     renderer->set_cloth(app.sim);
     const float scale = window->content_scale();

@@ -206,6 +206,7 @@ int run(CommandLine& cl) {
     if (!cl.scene_argument.empty()) cl.scene_name = cl.scene_argument;
     Scene scene = load_scene(cl.scene_name);
     for (const std::string& assignment : cl.overrides) apply_override(scene, assignment);
+    for (const std::string& note : scene.notes) std::cerr << "clothsim: note: " << note << "\n";
     if (cl.print_scene) {
         if (scene.cloth.is_mesh()) {
             const MassSpring sim = build_simulation(scene);

@@ -202,6 +202,18 @@ TEST_CASE("cli: --set changes the scene that is run") {
     CHECK(j.at("finite") == true);
 }
 
+TEST_CASE("cli: an old preset name runs the fabric it stood for, says so on stderr, and prints the new name") {
+    const RunResult r = run_clothsim({"--print-scene", "--scene", "hanging", "--set", "material.preset=silk"});
+    CAPTURE_RUN(r);
+    REQUIRE(r.code == 0);
+    CHECK_THAT(r.err, Contains("clothsim: note: material.preset = \"silk\" is an old name: it loads \"polyester-faille\""));
+    CHECK_THAT(r.out, Contains("preset = \"polyester-faille\""));
+    CHECK_THAT(r.out, !Contains("silk"));
+    const RunResult plain = run_clothsim({"--print-scene", "--scene", "hanging"});
+    REQUIRE(plain.code == 0);
+    CHECK(plain.err.empty());  // the bundled scenes use the presets' own names
+}
+
 TEST_CASE("cli: a scene given as a path to a .toml file is run") {
     const RunResult r = run_clothsim(
         {"--headless", "--scene", (kData / "scene_small.toml").string(), "--steps", "10", "--json"});

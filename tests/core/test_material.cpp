@@ -269,15 +269,15 @@ TEST_CASE("material: a preset fills the fields a scene does not set, in any orde
     }
     // A per-spring scene that does not set its per-spring fields itself takes a preset from --set.
     Scene bundled = parse_scene("name = \"x\"\n", "t.toml");
-    apply_override(bundled, "material.preset=silk");
-    CHECK(bundled.material.density == find_material_preset("silk")->density);
+    apply_override(bundled, "material.preset=polyester-faille");
+    CHECK(bundled.material.density == find_material_preset("polyester-faille")->density);
     const MassSpring sim = build_simulation(bundled);
     CHECK(sim.bend_count() > 0);
     // Another preset later keeps the explicit field.
     apply_override(bundled, "material.stretch=[900, 300]");
-    apply_override(bundled, "material.preset=cotton");
+    apply_override(bundled, "material.preset=cotton-broadcloth");
     CHECK(bundled.material.stretch == glm::vec2(900.0f, 300.0f));
-    CHECK(bundled.material.density == find_material_preset("cotton")->density);
+    CHECK(bundled.material.density == find_material_preset("cotton-broadcloth")->density);
     // Every preset builds and steps.
     for (const MaterialPreset& p : material_presets()) {
         Scene s = load_scene("hanging");
@@ -292,6 +292,46 @@ TEST_CASE("material: a preset fills the fields a scene does not set, in any orde
     }
 }
 
+TEST_CASE("material: an old preset name loads the fabric it stood for, saved under that fabric's name, with a note "
+          "that says so; a preset's own name gives no note", "[material]") {
+    const struct {
+        const char* old_name;
+        const char* name;
+    } renamed[] = {{"silk", "polyester-faille"}, {"wool-jersey", "gray-interlock"}, {"cotton", "cotton-broadcloth"},
+                   {"polyester", "polyester-tropical"}};
+    for (const auto& r : renamed) {
+        INFO(r.old_name);
+        const MaterialPreset* preset = find_material_preset(r.name);
+        REQUIRE(preset);
+        REQUIRE(find_material_preset(r.old_name) == preset);
+        // From a file and from --set alike.
+        Scene from_file = parse_scene(std::string("[material]\npreset = \"") + r.old_name + "\"\n", "t.toml");
+        Scene from_set = parse_scene("name = \"x\"\n", "t.toml");
+        apply_override(from_set, std::string("material.preset=") + r.old_name);
+        for (const Scene* s : {&from_file, &from_set}) {
+            CHECK(s->material.preset == r.name);
+            CHECK(s->material.density == preset->density);
+            CHECK(s->material.stretch == preset->stretch);
+            CHECK(s->material.bending == preset->bending);
+            REQUIRE(s->notes.size() == 1);
+            CHECK_THAT(s->notes[0], Catch::Contains(std::string("\"") + r.old_name + "\" is an old name") &&
+                                        Catch::Contains(std::string("loads \"") + r.name + "\""));
+            // Written out, it reads back under the fabric's own name, with nothing to note.
+            const Scene again = parse_scene(to_toml(*s), "again.toml");
+            CHECK(again.material.preset == r.name);
+            CHECK(again.notes.empty());
+        }
+    }
+    // The two fabrics never measured are named nowhere as presets.
+    for (const MaterialPreset& p : material_presets()) {
+        CHECK(std::string(p.name).find("silk") == std::string::npos);
+        CHECK(std::string(p.name).find("wool") == std::string::npos);
+        CHECK_FALSE(std::string(p.note).empty());
+    }
+    Scene plain = parse_scene("[material]\npreset = \"denim\"\n", "t.toml");
+    CHECK(plain.notes.empty());
+}
+
 TEST_CASE("material: a scene that sets both forms is refused with the fields that clash", "[material]") {
     CHECK_THROWS_WITH(parse_scene("[cloth]\nmass = 0.3\n[springs]\nshear = 10\n[material]\npreset = \"denim\"\n", "a.toml"),
                       Catch::Contains("a.toml:") && Catch::Contains("cloth.mass, springs.shear") &&
@@ -304,7 +344,7 @@ TEST_CASE("material: a scene that sets both forms is refused with the fields tha
     Scene per_spring = parse_scene("[springs]\nbending = 4\n", "c.toml");
     CHECK_THROWS_WITH(apply_override(per_spring, "material.density=0.2"), Catch::Contains("springs.bending"));
     CHECK_THROWS_WITH(parse_scene("[material]\npreset = \"tweed\"\n", "d.toml"),
-                      Catch::Contains("d.toml:2") && Catch::Contains("cotton, denim, silk, wool-jersey, polyester"));
+                      Catch::Contains("d.toml:2") && Catch::Contains("cotton-broadcloth, denim, polyester-faille, gray-interlock, polyester-tropical"));
     // Changing rows and then cols one --set at a time passes through long thin cells: allowed, with a note.
     Scene knit = parse_scene("[cloth]\nsize = 0.3\nrows = 41\ncols = 41\n[material]\npreset = \"wool-jersey\"\n", "k.toml");
     apply_override(knit, "cloth.rows=81");
@@ -357,10 +397,10 @@ TEST_CASE("material: derived per-spring values are not range-checked as if the u
 
 TEST_CASE("material: a scene written out reads back the same, with the derived per-spring values as comments",
           "[material]") {
-    const Scene s = parse_scene("[cloth]\nrows = 12\ncols = 12\n[material]\npreset = \"wool-jersey\"\nshear = 20\n", "t.toml");
+    const Scene s = parse_scene("[cloth]\nrows = 12\ncols = 12\n[material]\npreset = \"gray-interlock\"\nshear = 20\n", "t.toml");
     const std::string text = to_toml(s);
     INFO(text);
-    CHECK(text.find("preset = \"wool-jersey\"") != std::string::npos);
+    CHECK(text.find("preset = \"gray-interlock\"") != std::string::npos);
     CHECK(text.find("\nshear = 20.0") != std::string::npos);
     CHECK(text.find("density =") == std::string::npos);  // follows the preset
     CHECK(text.find("# structural = ") != std::string::npos);

@@ -141,10 +141,11 @@ TEST_CASE("scene: a bundled scene loads the values written in its file") {
     CHECK(s.settings.forces.wind_model == clothsim::WindModel::Triangles);
     CHECK(s.settings.integration.substeps == 145);
     // Its fabric is a preset: the material fields are the preset's, and the mass is derived from its density.
-    const clothsim::MaterialPreset* polyester = clothsim::find_material_preset("polyester");
+    const clothsim::MaterialPreset* polyester = clothsim::find_material_preset("polyester-tropical");
     REQUIRE(polyester);
     CHECK(s.material.enabled);
-    CHECK(s.material.preset == "polyester");
+    CHECK(s.material.preset == "polyester-tropical");
+    CHECK(s.notes.empty());
     CHECK(s.material.density == polyester->density);
     CHECK(s.material.stretch == polyester->stretch);
     CHECK(s.per_spring_fields == 0);

@@ -5,6 +5,7 @@
 #include "clothsim/cloth_mesh.hpp"
 
 #include <array>
+#include <optional>
 #include <algorithm>
 #include <cmath>
 #include <tuple>
@@ -18,20 +19,33 @@ namespace {
 // Measured fabrics. Every number and its source: docs/MATERIAL.md, "Presets".
 // clang-format off
 constexpr std::array kPresets = {
-    MaterialPreset{"cotton", 0.124f, {4033.0f, 4070.0f}, 105.0f, {1.16e-5f, 1.16e-5f},
-                   "cotton broadcloth (density, bending: Matsudaira et al. 2015); stretch, shear of a 65/35 "
-                   "cotton/polyester shirting (Wang et al. 2011)"},
+    MaterialPreset{"cotton-broadcloth", 0.124f, {4033.0f, 4070.0f}, 105.0f, {1.16e-5f, 1.16e-5f},
+                   "cotton broadcloth: density, bending (Matsudaira et al. 2015, fabric A); stretch, shear of "
+                   "the closest measured fabric, a 65/35 cotton/polyester shirting (Wang et al. 2011)"},
     MaterialPreset{"denim", 0.324f, {8891.0f, 8891.0f}, 122.5f, {1.69e-5f, 1.69e-5f},
-                   "KES-F of denim sample A (Kumari & Khurana 2016: stretch as the 0-500 gf/cm secant, shear, "
+                   "denim: KES-F of sample A (Kumari & Khurana 2016: stretch as the 0-500 gf/cm secant, shear, "
                    "bending); density of an 11 oz denim (Wang et al. 2011)"},
-    MaterialPreset{"silk", 0.104f, {86.0f, 343.0f}, 14.3f, {1.86e-6f, 1.86e-6f},
-                   "stand-in, no silk data found: polyester faille (density, bending: Matsudaira et al. 2015), "
-                   "a light polyester (stretch, shear: Wang et al. 2011)"},
-    MaterialPreset{"wool-jersey", 0.187f, {33.0f, 69.0f}, 37.0f, {7.7e-6f, 4.8e-6f},
-                   "stand-in, no wool jersey data found: a cotton/polyester interlock knit (Wang et al. 2011)"},
-    MaterialPreset{"polyester", 0.117f, {4004.0f, 4055.0f}, 19.2f, {7.55e-6f, 7.55e-6f},
-                   "polyester tropical (density, bending: Matsudaira et al. 2015); stretch, shear of a 100% "
-                   "polyester (Wang et al. 2011)"},
+    MaterialPreset{"polyester-faille", 0.104f, {86.0f, 343.0f}, 14.3f, {1.86e-6f, 1.86e-6f},
+                   "polyester faille: density, bending (Matsudaira et al. 2015, fabric F); stretch, shear of "
+                   "the closest measured fabric, a light 100% polyester (Wang et al. 2011)"},
+    MaterialPreset{"gray-interlock", 0.187f, {33.0f, 69.0f}, 37.0f, {7.7e-6f, 4.8e-6f},
+                   "gray interlock, a 60/40 cotton/polyester interlock knit: every field measured (Wang et al. "
+                   "2011)"},
+    MaterialPreset{"polyester-tropical", 0.117f, {4004.0f, 4055.0f}, 19.2f, {7.55e-6f, 7.55e-6f},
+                   "polyester tropical: density, bending (Matsudaira et al. 2015, fabric C); stretch, shear of "
+                   "the closest measured fabric, a 100% polyester (Wang et al. 2011)"},
+};
+// Names the presets had. Each still loads, with a note: two named fabrics that were never measured (silk,
+// wool jersey) and stood in for by the fabrics now named, and two names of a fibre for one fabric of it.
+struct PresetAlias {
+    std::string_view old_name, name, why;
+};
+constexpr std::array kPresetAliases = {
+    PresetAlias{"cotton", "cotton-broadcloth", "the cotton fabric measured"},
+    PresetAlias{"polyester", "polyester-tropical", "the polyester fabric measured"},
+    PresetAlias{"silk", "polyester-faille", "no silk was measured; it is the fabric that stood in for silk"},
+    PresetAlias{"wool-jersey", "gray-interlock", "no wool jersey was measured; it is the cotton/polyester knit that "
+                                                 "stood in for wool jersey"},
 };
 // clang-format on
 
@@ -76,10 +90,23 @@ std::string join(const std::array<FieldBit, 4>& fields, unsigned bits) {
 std::span<const MaterialPreset> material_presets() { return kPresets; }
 
 const MaterialPreset* find_material_preset(std::string_view name) {
+    for (const PresetAlias& a : kPresetAliases) {
+        if (a.old_name == name) name = a.name;
+    }
     for (const MaterialPreset& p : kPresets) {
         if (p.name == name) return &p;
     }
     return nullptr;
+}
+
+std::optional<std::string> material_preset_alias_note(std::string_view name) {
+    for (const PresetAlias& a : kPresetAliases) {
+        if (a.old_name == name) {
+            return "material.preset = \"" + std::string(a.old_name) + "\" is an old name: it loads \"" +
+                   std::string(a.name) + "\" (" + std::string(a.why) + ")";
+        }
+    }
+    return std::nullopt;
 }
 
 glm::dvec2 grid_spacing(const ClothSettings& cloth) {
@@ -133,6 +160,10 @@ void note_field_set(Scene& scene, std::string_view field) {
     }
     if (field == "material.preset") {
         m.enabled = true;
+        if (const std::optional<std::string> note = material_preset_alias_note(m.preset)) {
+            m.preset = find_material_preset(m.preset)->name;  // saved under the name of what it is
+            scene.notes.push_back(*note);
+        }
         apply_preset(m);
         return;
     }

@@ -42,7 +42,7 @@ const std::array kFields = {
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
     FieldInfo{"material.enabled", "", 0, 0, "whether [material] describes the cloth (any other material field turns it on); false returns to the per-spring form, keeping the mass and spring constants derived on this grid", [](Scene& s) -> FieldRef { return &s.material.enabled; }},
-    FieldInfo{"material.preset", "", 0, 0, "a measured fabric (cotton, denim, silk, wool-jersey, polyester) that fills the material fields this scene does not set", [](Scene& s) -> FieldRef { return &s.material.preset; }},
+    FieldInfo{"material.preset", "", 0, 0, "a measured fabric (cotton-broadcloth, denim, polyester-faille, gray-interlock, polyester-tropical; the old names cotton, polyester, silk and wool-jersey load with a note) that fills the material fields this scene does not set", [](Scene& s) -> FieldRef { return &s.material.preset; }},
     FieldInfo{"material.density", "kg/m^2", 1e-3, 100, "areal density (mass per area)", [](Scene& s) -> FieldRef { return &s.material.density; }},
     FieldInfo{"material.stretch", "N/m", 1e-2, 1e7, "membrane tensile stiffness (force per width per strain): one number, or [warp along u_axis, weft along v_axis]", [](Scene& s) -> FieldRef { return &s.material.stretch; }},
     FieldInfo{"material.shear", "N/m", 0, 1e7, "in-plane shear stiffness (force per width per radian of shear)", [](Scene& s) -> FieldRef { return &s.material.shear; }},

@@ -49,6 +49,17 @@ Scene hanging(int n, float tether_strain) {
     return s;
 }
 
+// `s` on the fast path with its tethers on `threads` threads, after `steps` steps.
+MassSpring fast_run(Scene s, int threads, int steps) {
+    s.settings.solver.threads = threads;
+    s.settings.solver.method = SolverMethod::Fast;
+    MassSpring fast = build_simulation(s);
+    REQUIRE(fast.plan().path == StepPath::FastVerlet);
+    REQUIRE(fast.plan().tethers);
+    fast.run_steps(steps);
+    return fast;
+}
+
 }  // namespace
 
 TEST_CASE("tethers: each free particle is tied to the nearest pin of each pin cluster", "[tethers]") {
@@ -124,12 +135,7 @@ TEST_CASE("tethers: on the fast solver's bands and threads the cloth is the text
         REQUIRE(textbook.plan().path == StepPath::TextbookVerlet);
         textbook.run_steps(60);
         for (int threads : test::thread_counts({1, 2, 3})) {
-            s.settings.solver.threads = threads;
-            s.settings.solver.method = SolverMethod::Fast;
-            MassSpring fast = build_simulation(s);
-            REQUIRE(fast.plan().path == StepPath::FastVerlet);
-            REQUIRE(fast.plan().tethers);
-            fast.run_steps(60);
+            const MassSpring fast = fast_run(s, threads, 60);
             INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
             CHECK(fast.tethers_at_limit() == textbook.tethers_at_limit());
             CHECK(fast.tethers_at_limit() > 0);
@@ -163,12 +169,7 @@ TEST_CASE("tethers: on the fast path the cloth swings into a sphere as on the te
         missed.run_steps(60);
         REQUIRE_FALSE(test::bit_identical(missed, textbook));  // the sphere is met
         for (int threads : test::thread_counts({1, 2, 3})) {
-            s.settings.solver.threads = threads;
-            s.settings.solver.method = SolverMethod::Fast;
-            MassSpring fast = build_simulation(s);
-            REQUIRE(fast.plan().path == StepPath::FastVerlet);
-            REQUIRE(fast.plan().tethers);
-            fast.run_steps(60);
+            const MassSpring fast = fast_run(s, threads, 60);
             INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
             CHECK(test::bit_identical(fast, textbook));
         }

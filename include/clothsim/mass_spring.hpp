@@ -254,6 +254,8 @@ private:
     // left to the collision stage. `made`: the bounds the boxes were already made with (by apply_tethers),
     // kept when the bounds are still the same.
     bool box_blocks_on_team(StepProfile* profile, const BlockBounds* made = nullptr);
+    // Sizes the collision blocks' boxes for the grid and records the bounds box_rows makes them with.
+    void start_boxes(BlockBounds bounds);
     // Boxes rows [begin, end) of the collision blocks (the fast solver's grid layout).
     void box_rows(int begin, int end, BlockBounds bounds);
     // Each returns whether it moved a particle.

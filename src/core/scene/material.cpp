@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <tuple>
+#include <utility>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -89,10 +90,19 @@ std::string join(const std::array<FieldBit, 4>& fields, unsigned bits) {
 
 std::span<const MaterialPreset> material_presets() { return kPresets; }
 
-const MaterialPreset* find_material_preset(std::string_view name) {
+namespace {
+
+const PresetAlias* alias_of(std::string_view old_name) {
     for (const PresetAlias& a : kPresetAliases) {
-        if (a.old_name == name) name = a.name;
+        if (a.old_name == old_name) return &a;
     }
+    return nullptr;
+}
+
+}  // namespace
+
+const MaterialPreset* find_material_preset(std::string_view name) {
+    if (const PresetAlias* a = alias_of(name)) name = a->name;
     for (const MaterialPreset& p : kPresets) {
         if (p.name == name) return &p;
     }
@@ -100,13 +110,10 @@ const MaterialPreset* find_material_preset(std::string_view name) {
 }
 
 std::optional<std::string> material_preset_alias_note(std::string_view name) {
-    for (const PresetAlias& a : kPresetAliases) {
-        if (a.old_name == name) {
-            return "material.preset = \"" + std::string(a.old_name) + "\" is an old name: it loads \"" +
-                   std::string(a.name) + "\" (" + std::string(a.why) + ")";
-        }
-    }
-    return std::nullopt;
+    const PresetAlias* a = alias_of(name);
+    if (!a) return std::nullopt;
+    return "material.preset = \"" + std::string(a->old_name) + "\" is an old name: it loads \"" + std::string(a->name) +
+           "\" (" + std::string(a->why) + ")";
 }
 
 glm::dvec2 grid_spacing(const ClothSettings& cloth) {
@@ -160,9 +167,9 @@ void note_field_set(Scene& scene, std::string_view field) {
     }
     if (field == "material.preset") {
         m.enabled = true;
-        if (const std::optional<std::string> note = material_preset_alias_note(m.preset)) {
-            m.preset = find_material_preset(m.preset)->name;  // saved under the name of what it is
-            scene.notes.push_back(*note);
+        if (std::optional<std::string> note = material_preset_alias_note(m.preset)) {
+            m.preset = alias_of(m.preset)->name;  // saved under the name of what it is
+            scene.notes.push_back(std::move(*note));
         }
         apply_preset(m);
         return;

@@ -402,10 +402,7 @@ std::size_t MassSpring::apply_tethers(const BlockBounds* boxes) {
     if (plan_.path != StepPath::FastVerlet || !in_->fast) return project_tethers(state_, in_->tethers, strain);
     std::array<std::size_t, 64> active{};
     const auto cols = static_cast<std::uint32_t>(topology_.cols);
-    if (boxes) {
-        in_->blocks.bounds = *boxes;
-        in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * blocks_per_row(topology_.cols));
-    }
+    if (boxes) start_boxes(*boxes);
     in_->fast->for_each_band([&](int band, int begin, int end) {
         const std::size_t first = first_tether_from(in_->tethers, static_cast<std::uint32_t>(begin) * cols);
         const std::size_t last = first_tether_from(in_->tethers, static_cast<std::uint32_t>(end) * cols);
@@ -431,10 +428,14 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile, const BlockBounds* mad
     const BlockBounds bounds = block_bounds_for(colliders_now(), in_->blocks);
     if (made && *made == bounds) return true;
     StageTimer timer(profile, Stage::BroadPhase);
-    in_->blocks.bounds = bounds;
-    in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * blocks_per_row(topology_.cols));
+    start_boxes(bounds);
     in_->fast->for_each_band([&](int, int begin, int end) { box_rows(begin, end, bounds); });
     return true;
+}
+
+void MassSpring::start_boxes(BlockBounds bounds) {
+    in_->blocks.bounds = bounds;
+    in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * blocks_per_row(topology_.cols));
 }
 
 void MassSpring::box_rows(int begin, int end, BlockBounds bounds) {

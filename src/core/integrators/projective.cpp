@@ -297,7 +297,7 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
     // materials"): L-BFGS with the global matrix as its initial Hessian, so its first iteration is exactly a
     // local-global step, and later ones add the curvature the constant matrix misses (a spring's transverse
     // stiffness, k (1 - L0/|d|), is nearly 0 at rest, while the matrix gives it k: plain local-global
-    // iterations crawl on the swinging and rotating modes of stiff cloth). Backtracking (Armijo) keeps every
+    // iterations crawl on the swinging and rotating modes of stiff cloth). A backtracking line search keeps every
     // iteration lowering g. grad g(x) = A x - b(x), b the right-hand side of the local step at x.
     constexpr int kMemory = 5;
     std::vector<Positions> s_history, y_history;
@@ -333,20 +333,40 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
             slope = dot(gradient, direction);
             if (!(slope < 0.0)) break;
         }
+        // A step is accepted by Armijo's sufficient decrease, or, where g's change is within its round-off, by
+        // the approximate Wolfe conditions of Hager & Zhang (2005, "A new conjugate gradient method with
+        // guaranteed descent and an efficient line search", SIAM J. Optim. 16(1), eq. 4.1): the slope along
+        // the direction has fallen to between sigma and 2 delta - 1 of its start. At small substeps g is the
+        // inertia's M'/h'^2 |x - y|^2 plus the springs' whole energy, and an iteration's decrease falls below
+        // g's round-off long before the gradient is small: Armijo alone then rejects every step and the
+        // iterations stop with the residual where it is.
+        constexpr double kArmijo = 1e-4, kDelta = 0.1, kSigma = 0.9;
+        const double round_off = 1e-12 * std::abs(energy);
         double step = 1.0;
-        Positions next;
+        Positions next, next_gradient;
         double next_energy = energy;
-        for (int halving = 0; halving < 20; ++halving, step *= 0.5) {
+        bool accepted = false;
+        for (int halving = 0; halving < 20 && !accepted; ++halving, step *= 0.5) {
             next = x + step * direction;
             write(next);
             next_energy = evaluate(next);
-            if (next_energy <= energy + 1e-4 * step * slope) break;
+            if (next_energy <= energy + kArmijo * step * slope) {
+                next_gradient = f.matrix * next - rhs;
+                accepted = true;
+            } else if (next_energy <= energy + round_off) {
+                next_gradient = f.matrix * next - rhs;
+                const double next_slope = dot(next_gradient, direction);
+                accepted = kSigma * slope <= next_slope && next_slope <= (2.0 * kDelta - 1.0) * slope;
+            }
         }
-        if (!(next_energy <= energy)) {  // no decrease left along the direction: converged to round-off
+        if (!accepted && next_energy <= energy) {  // the shortest step still lowers g: taken
+            next_gradient = f.matrix * next - rhs;
+            accepted = true;
+        }
+        if (!accepted) {  // no decrease left along the direction: converged to round-off
             write(x);
             break;
         }
-        Positions next_gradient = f.matrix * next - rhs;
         Positions s_k = next - x, y_k = next_gradient - gradient;
         const double sy = dot(s_k, y_k);
         if (sy > 1e-300) {

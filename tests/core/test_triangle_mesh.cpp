@@ -226,6 +226,38 @@ TEST_CASE("triangle mesh contact grid answers as the tree does, and stays bounde
     CHECK(on->distance == Approx(0.5e-6));
 }
 
+TEST_CASE("triangle mesh a needle's nearest point is on it, and the contact grid answers as the tree does",
+          "[triangle_mesh]") {
+    // The fuzzer's find (tests/fuzz/corpus/mesh/needle-triangle.obj): triangle 4 has two edges of about 2 m and
+    // one of 1.4e-22 m, beside zero-area ones. Its face regions' differences cancel to noise and picked a point
+    // off it for a cell's centre, so the grid left it out of a cell where the tree found it; it is measured by
+    // its edges, within its width of every point of it.
+    const TriangleMesh mesh({{0, 0, 5}, {1, 0, 0}, {1, 0, 0}, {1, 4, 0}, {1, 0, 0}, {1, 1, 0}, {1, 0, 0}, {1, 4, 0},
+                             {1, 0, 0}, {1, 4, 0}, {1e-22, 0, 0}, {0, 0, 1e-22}, {0, 1, 0}, {0, 1, 2}},
+                            {{1, 2, 3}, {5, 6, 7}, {7, 8, 9}, {0, 1, 2}, {11, 10, 13}, {0, 2, 1}});
+    const glm::dvec3 lo = mesh.lo(), hi = mesh.hi();
+    const double band = 0.05 * glm::length(hi - lo) + 1e-6;
+    const auto grid = mesh.contact_grid(band);
+    auto to_segment = [](glm::dvec3 p, glm::dvec3 u, glm::dvec3 v) {
+        const double t = std::clamp(glm::dot(p - u, v - u) / glm::dot(v - u, v - u), 0.0, 1.0);
+        return glm::length(p - (u + t * (v - u)));
+    };
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int k = 0; k < 3000; ++k) {
+        // The fuzz target's 27 points first, then random ones near the needle.
+        const glm::dvec3 p = k < 27 ? lo + 0.5 * glm::dvec3(k % 3, (k / 3) % 3, k / 9) * (hi - lo) + glm::dvec3(0.3, -0.2, 0.1) * band
+                                    : glm::dvec3(unit(rng) - 0.5, 1.5 * unit(rng) - 0.25, 2.5 * unit(rng) - 0.25);
+        INFO("point " << k << ": " << p.x << ", " << p.y << ", " << p.z);
+        const auto by_tree = mesh.nearest(p, band), by_grid = mesh.nearest(p, band, *grid);
+        REQUIRE(by_tree.has_value() == by_grid.has_value());
+        const double to_needle = std::min(to_segment(p, {0, 0, 1e-22}, {0, 1, 2}), to_segment(p, {1e-22, 0, 0}, {0, 1, 2}));
+        const auto anywhere = mesh.nearest(p, INFINITY);
+        REQUIRE(anywhere);
+        CHECK(anywhere->distance <= to_needle + 1e-12);
+    }
+}
+
 TEST_CASE("triangle mesh contact grid knows which of its cells that list no triangle lie inside a closed mesh",
           "[triangle_mesh]") {
     // The icosphere's grid at a 1 cm band has cells that list no triangle inside the ball and around it: a point

@@ -47,9 +47,13 @@ Closest closest_on_edges(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c)
 // region p lies in.
 Closest closest_on_triangle(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
     const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-    // Without area (coincident or collinear corners) the regions below divide by zero: the edges instead.
-    const glm::dvec3 normal = glm::cross(ab, ac);
-    if (!(glm::dot(normal, normal) > 1e-24 * glm::dot(ab, ab) * glm::dot(ac, ac))) return closest_on_edges(p, a, b, c);
+    // Without area (coincident or collinear corners) the regions below divide by zero, and on a needle (a width
+    // under 1e-12 of its longest edge, as a triangle with one edge of 1e-22 m and two of 2 m) their differences
+    // cancel to noise and pick the wrong region, a point off the triangle: the edges instead, which lie within
+    // that width of every point of it.
+    const glm::dvec3 normal = glm::cross(ab, ac), bc = c - b;
+    const double longest = std::max({glm::dot(ab, ab), glm::dot(ac, ac), glm::dot(bc, bc)});
+    if (!(glm::dot(normal, normal) > 1e-24 * longest * longest)) return closest_on_edges(p, a, b, c);
     const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) return {a, Feature::Vertex, 0};
     const glm::dvec3 bp = p - b;

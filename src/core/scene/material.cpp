@@ -17,24 +17,50 @@
 namespace clothsim {
 namespace {
 
-// Measured fabrics. Every number and its source: docs/MATERIAL.md, "Presets".
+// Measured fabrics. Every number and its source: docs/MATERIAL.md, "Presets". A Wang et al. 2011 fabric is its
+// released file's zero-strain row as ARCSim's forces read it (docs/MATERIAL.md, "Wang et al.'s files"): the
+// tensile stiffness with the other direction free, 2 (c11 - c12^2 / c22) and 2 (c22 - c12^2 / c11) with c12
+// clamped to 0; shear c33; bending the lowest-curvature sample along warp and weft over 3. A Matsudaira et al.
+// 2015 fabric is its KES B (1 gf cm^2/cm = 9.80665e-5 N m) and weight, with the stretch and shear of the
+// closest fabric Wang et al. measured.
 // clang-format off
 constexpr std::array kPresets = {
     MaterialPreset{"cotton-broadcloth", 0.124f, {4033.0f, 4070.0f}, 105.0f, {1.16e-5f, 1.16e-5f},
                    "cotton broadcloth: density, bending (Matsudaira et al. 2015, fabric A); stretch, shear of "
-                   "the closest measured fabric, a 65/35 cotton/polyester shirting (Wang et al. 2011)"},
+                   "the closest measured fabric, royal-target, a 65/35 cotton/polyester (Wang et al. 2011)"},
     MaterialPreset{"denim", 0.324f, {8891.0f, 8891.0f}, 122.5f, {1.69e-5f, 1.69e-5f},
                    "denim: KES-F of sample A (Kumari & Khurana 2016: stretch as the 0-500 gf/cm secant, shear, "
                    "bending); density of an 11 oz denim (Wang et al. 2011)"},
-    MaterialPreset{"polyester-faille", 0.104f, {86.0f, 343.0f}, 14.3f, {1.86e-6f, 1.86e-6f},
+    MaterialPreset{"polyester-faille", 0.104f, {51.6f, 205.6f}, 14.3f, {1.86e-6f, 1.86e-6f},
                    "polyester faille: density, bending (Matsudaira et al. 2015, fabric F); stretch, shear of "
-                   "the closest measured fabric, a light 100% polyester (Wang et al. 2011)"},
-    MaterialPreset{"gray-interlock", 0.187f, {33.0f, 69.0f}, 37.0f, {7.7e-6f, 4.8e-6f},
-                   "gray interlock, a 60/40 cotton/polyester interlock knit: every field measured (Wang et al. "
-                   "2011)"},
+                   "the closest measured fabric, tango-red-jet-set, a light 100% polyester (Wang et al. 2011)"},
+    MaterialPreset{"gray-interlock", 0.187f, {33.2f, 69.0f}, 36.9f, {7.73e-6f, 4.76e-6f},
+                   "gray interlock, a 60/40 cotton/polyester interlock knit (t-shirt): every field measured "
+                   "(Wang et al. 2011)"},
+    MaterialPreset{"wool-tropical", 0.163f, {4004.0f, 4055.0f}, 19.2f, {6.57e-6f, 6.57e-6f},
+                   "wool tropical, a 100% wool plain weave: density, bending (Matsudaira et al. 2015, fabric B); "
+                   "stretch, shear of the closest measured fabric, white-dots-on-blk, a woven 100% polyester (Wang et "
+                   "al. 2011)"},
     MaterialPreset{"polyester-tropical", 0.117f, {4004.0f, 4055.0f}, 19.2f, {7.55e-6f, 7.55e-6f},
                    "polyester tropical: density, bending (Matsudaira et al. 2015, fabric C); stretch, shear of "
-                   "the closest measured fabric, a 100% polyester (Wang et al. 2011)"},
+                   "the closest measured fabric, white-dots-on-blk, a 100% polyester (Wang et al. 2011)"},
+    MaterialPreset{"11oz-black-denim", 0.324f, {410.5f, 2026.8f}, 53.4f, {2.14e-5f, 3.23e-5f},
+                   "11 oz black denim, 99/1 cotton/spandex (jeans): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"camel-ponte-roma", 0.284f, {62.3f, 88.1f}, 31.9f, {1.21e-5f, 1.24e-5f},
+                   "camel ponte roma, a 60/40 polyester/rayon knit (jacket): every field measured (Wang et al. "
+                   "2011)"},
+    MaterialPreset{"ivory-rib-knit", 0.276f, {85.7f, 130.3f}, 83.2f, {1.54e-5f, 1.07e-5f},
+                   "ivory rib knit, 95/5 cotton/spandex (underwear): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"pink-ribbon-brown", 0.228f, {211.2f, 341.3f}, 30.3f, {3.90e-5f, 1.99e-5f},
+                   "pink ribbon brown, a 100% polyester (blanket): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"royal-target", 0.220f, {4033.0f, 4070.0f}, 105.0f, {4.18e-5f, 4.18e-5f},
+                   "royal target, a 65/35 cotton/polyester (pants): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"tango-red-jet-set", 0.113f, {51.6f, 205.6f}, 14.3f, {4.76e-6f, 6.78e-6f},
+                   "tango red jet set, a 100% polyester (jacket): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"white-dots-on-blk", 0.128f, {4004.0f, 4055.0f}, 19.2f, {1.72e-5f, 1.04e-5f},
+                   "white dots on black, a 100% polyester (tablecloth): every field measured (Wang et al. 2011)"},
+    MaterialPreset{"white-swim-solid", 0.204f, {95.1f, 207.3f}, 60.8f, {2.01e-5f, 1.70e-5f},
+                   "white swim solid, 87/13 nylon/spandex (swimsuit): every field measured (Wang et al. 2011)"},
 };
 // Names the presets had. Each still loads, with a note: two named fabrics that were never measured (silk,
 // wool jersey) and stood in for by the fabrics now named, and two names of a fibre for one fabric of it.

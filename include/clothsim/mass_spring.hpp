@@ -114,7 +114,8 @@ public:
     bool fast_solver_available() const;
     int solver_threads() const;
     // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
-    // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth).
+    // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth) or its coloured form (coloured_xpbd.hpp:
+    // the same on a mesh cloth).
     bool last_step_fast() const;
     // Tethers to the pins (tethers.hpp; they act when springs.tether_strain > 0), and how many were at their
     // limit in the last substep.

@@ -864,15 +864,16 @@ void stats_section(const AppState& app) {
         ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                     app.sim.time());
     }
-    // The fast path runs position Verlet (the fast solver) and XPBD (its grid form); every other integrator
-    // uses the shared textbook force path.
+    // The fast path runs position Verlet (the fast solver) and XPBD (its grid form, or on a mesh cloth its
+    // coloured form, scalar); every other integrator uses the shared textbook force path.
     const bool fast = app.sim.last_step_fast();
     const double per_substep_us = app.stats.substeps_last_frame > 0
                                       ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
                                       : 0.0;
     if (fast) {
-        ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep", MassSpring::fast_kernel_name(),
-                    app.sim.solver_threads(), app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
+        ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep",
+                    app.sim.topology().mesh ? "colours" : MassSpring::fast_kernel_name(), app.sim.solver_threads(),
+                    app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
     } else {
         ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);
     }

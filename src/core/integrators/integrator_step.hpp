@@ -6,6 +6,7 @@
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
+#include "integrators/coloured_xpbd.hpp"
 #include "integrators/grid_xpbd.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/projective.hpp"
@@ -22,8 +23,11 @@ struct IntegratorCaches {
     ProjectiveSolver projective;
     XpbdMultipliers xpbd;
     std::optional<GridXpbd> grid_xpbd;  // XPBD's fast path, made from the topology when it is a grid
-    bool grid_xpbd_current = false;     // grid_xpbd matches the topology and the stiffness
+    // ... and made from any other topology (a mesh cloth): its elements in colours
+    std::optional<ColouredXpbd> coloured_xpbd;
+    bool grid_xpbd_current = false;     // grid_xpbd and coloured_xpbd match the topology and the stiffness
     bool grid_xpbd_ran = false;         // the last XPBD substep was the grid form's
+    bool coloured_xpbd_ran = false;     // ... the coloured form's
 };
 
 struct IntegratorContext {

@@ -1,6 +1,7 @@
 #include "integrators/integrators.hpp"
 #include "integrators/integrator_step.hpp"
 
+#include "integrators/xpbd_projection.hpp"
 #include "model/forces.hpp"
 
 #include <glm/geometric.hpp>
@@ -24,60 +25,24 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         if (state.pinned[i]) continue;
         state.position.add(i, state.motion.get(i) + a.get(i) * (h * h));  // x + h (v + h a)
     }
-    // One Gauss-Seidel pass over the springs; with lambda starting at 0 each substep,
-    // d_lambda = -C / (w_a + w_b + alpha~), alpha~ = 1 / (k h^2), and x_a -= w_a lambda n, x_b += w_b lambda n with
-    // n = d / |d|, computed as lambda / |d| times d. GridXpbd (grid_xpbd.hpp) does the same arithmetic in
-    // another order.
+    // One Gauss-Seidel pass over the springs, then the bends, then the hinges, in list order
+    // (xpbd_projection.hpp). GridXpbd (grid_xpbd.hpp) and ColouredXpbd (coloured_xpbd.hpp) do the same
+    // arithmetic in other orders.
     multipliers.spring.assign(topology.springs.size(), 0.0);
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
     multipliers.hinge.assign(topology.hinges.size(), glm::dvec3(0.0));
     double violation2 = 0.0;
     for (std::size_t j = 0; j < topology.springs.size(); ++j) {
-        const Spring& s = topology.springs[j];
-        const double k = stiffness_of(springs, s);
-        if (k == 0.0) continue;
-        const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
-        const glm::dvec3 d = state.position.get(s.b) - state.position.get(s.a);
-        const double length = std::sqrt((d.x * d.x + d.y * d.y) + d.z * d.z);
-        if (!(length > 1e-12)) continue;
-        const double c = length - static_cast<double>(s.rest_length);
-        const double lambda = -c / ((wa + wb) + 1.0 / (k * h * h));
-        multipliers.spring[j] = lambda;
-        violation2 += c * c;
-        const double g = lambda / length;
-        state.position.add(s.a, d * -(wa * g));
-        state.position.add(s.b, d * (wb * g));
+        const double k = stiffness_of(springs, topology.springs[j]);
+        if (k != 0.0) violation2 += project_spring(state, topology.springs[j], k, h, multipliers.spring[j]);
     }
-    // Bends: the vector constraint C = x_a - 2 x_m + x_b with compliance 1 / (k h^2) and gradients I, -2 I, I:
-    // d_lambda = -C / (w_a + 4 w_m + w_b + 1 / (k h^2)).
     for (std::size_t j = 0; j < topology.bends.size(); ++j) {
-        const Bend& b = topology.bends[j];
-        const double k = stiffness_of(springs, b);
-        if (k == 0.0) continue;
-        const double wa = state.inverse_mass[b.a], wm = state.inverse_mass[b.m], wb = state.inverse_mass[b.b];
-        const glm::dvec3 c = bend_difference(state.position, b);
-        const glm::dvec3 lambda = c * (-1.0 / (((wa + 4.0 * wm) + wb) + 1.0 / (k * h * h)));
-        multipliers.bend[j] = lambda;
-        violation2 += (c.x * c.x + c.y * c.y) + c.z * c.z;
-        state.position.add(b.a, wa * lambda);
-        state.position.add(b.m, (-2.0 * wm) * lambda);
-        state.position.add(b.b, wb * lambda);
+        const double k = stiffness_of(springs, topology.bends[j]);
+        if (k != 0.0) violation2 += project_bend(state, topology.bends[j], k, h, multipliers.bend[j]);
     }
-    // Hinges: the vector constraint C = sum_i c_i x_i with gradients c_i I:
-    // d_lambda = -C / (sum_i w_i c_i^2 + 1 / (k h^2)).
     for (std::size_t j = 0; j < topology.hinges.size(); ++j) {
-        const Hinge& hinge = topology.hinges[j];
-        const double k = stiffness_of(springs, hinge);
-        if (k == 0.0) continue;
-        double w = 0.0;
-        for (int i = 0; i < 4; ++i) w += double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i]) * double(hinge.c[i]);
-        const glm::dvec3 c = hinge_difference(state.position, hinge);
-        const glm::dvec3 lambda = c * (-1.0 / (w + 1.0 / (k * h * h)));
-        multipliers.hinge[j] = lambda;
-        violation2 += (c.x * c.x + c.y * c.y) + c.z * c.z;
-        for (int i = 0; i < 4; ++i) {
-            state.position.add(hinge.v[i], (double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i])) * lambda);
-        }
+        const double k = stiffness_of(springs, topology.hinges[j]);
+        if (k != 0.0) violation2 += project_hinge(state, topology.hinges[j], k, h, multipliers.hinge[j]);
     }
     for (std::size_t i = 0; i < n; ++i) {
         state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));
@@ -120,19 +85,26 @@ double xpbd_residual(const DVec3Array& position, const Topology& topology, const
     return first > 0.0 ? std::sqrt(residual2) / first : 0.0;
 }
 
-// The grid form (grid_xpbd.hpp) on a grid cloth with solver.method = "fast", the list order otherwise. Its
-// residual is measured when asked (MassSpring::last_solver_residual), so the substep pays nothing for it.
+// The grid form (grid_xpbd.hpp) on a grid cloth with solver.method = "fast", the coloured form
+// (coloured_xpbd.hpp) on any other cloth with it, the list order otherwise. Its residual is measured when asked
+// (MassSpring::last_solver_residual), so the substep pays nothing for it.
 void xpbd_substep(IntegratorContext& c) {
     IntegratorCaches& caches = c.caches;
     const bool fast = c.settings.solver.method == SolverMethod::Fast;
     if (fast && !caches.grid_xpbd_current) {
         caches.grid_xpbd = GridXpbd::for_topology(c.topology);
         if (caches.grid_xpbd) caches.grid_xpbd->set_stiffness(c.topology, c.settings.springs);
+        caches.coloured_xpbd.reset();
+        if (!caches.grid_xpbd) caches.coloured_xpbd = ColouredXpbd::for_topology(c.topology);
         caches.grid_xpbd_current = true;
     }
     caches.grid_xpbd_ran = fast && caches.grid_xpbd.has_value();
+    caches.coloured_xpbd_ran = fast && !caches.grid_xpbd_ran && caches.coloured_xpbd.has_value();
     if (caches.grid_xpbd_ran) {
         caches.grid_xpbd->step(c.state, c.dynamics, c.h, c.settings.solver.threads);
+    } else if (caches.coloured_xpbd_ran) {
+        caches.coloured_xpbd->step(c.state, c.dynamics, c.topology, c.settings.springs, c.h, c.settings.solver.threads,
+                                   caches.xpbd);
     } else {
         step_xpbd(c.state, c.dynamics, c.topology, c.settings.springs, c.h, caches.xpbd);
     }

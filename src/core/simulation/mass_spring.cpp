@@ -120,8 +120,10 @@ bool MassSpring::use_fast_kernel(const std::string& name) {
 
 int MassSpring::solver_threads() const {
     if (plan_.path != StepPath::FastVerlet) {
-        const bool grid = last_step_fast() && in_->iterative.grid_xpbd;
-        return grid ? in_->iterative.grid_xpbd->last_threads() : 1;
+        const IntegratorCaches& xpbd = in_->iterative;
+        if (!last_step_fast()) return 1;
+        if (xpbd.grid_xpbd_ran) return xpbd.grid_xpbd->last_threads();
+        return xpbd.coloured_xpbd->last_threads();
     }
     const bool set_aside = settings_.solver.threads == 0 && in_->fast->team_set_aside();
     return set_aside ? 1 : in_->fast->effective_threads(settings_.solver.threads);
@@ -130,7 +132,7 @@ int MassSpring::solver_threads() const {
 bool MassSpring::last_step_fast() const {
     if (plan_.path == StepPath::FastVerlet) return true;
     return settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd &&
-           in_->iterative.grid_xpbd_ran;
+           (in_->iterative.grid_xpbd_ran || in_->iterative.coloured_xpbd_ran);
 }
 
 double MassSpring::substep_length() const {

@@ -1,0 +1,65 @@
+// XPBD on any topology, in colours: the `xpbd` integrator's fast path for a cloth that is not a grid (a mesh
+// cloth; solver.method = "fast").
+//
+// The same method and arithmetic per constraint as step_xpbd (integrators.hpp: Macklin et al. 2016, one
+// projection per substep as in "Small Steps", Macklin et al. 2019), in another order. step_xpbd projects the
+// elements in list order, each waiting for the positions the one before wrote, so no two can run at once.
+// Here each kind of element (springs, then bends, then hinges, as step_xpbd) is split into colours by a greedy
+// graph colouring (each element takes the lowest colour that no element sharing a particle with it has taken
+// yet, in list order; Welsh & Powell 1967's greedy scheme, as in Fratarcangeli & Pellacini 2015 for
+// position-based dynamics on the GPU). The elements of one colour share no particle: each reads and writes
+// only its own particles, so a colour runs on the whole team at once, and its result does not depend on the
+// order within it or on the thread count. Gauss-Seidel in this order is the list-order projection of the
+// elements listed colour by colour (each colour's in list order): step_xpbd on such a topology gives the same
+// positions bit for bit (the tests check it). Only the sum of the violations that the residual is relative to
+// may round differently (it is summed piece by piece).
+#pragma once
+
+#include "integrators/integrators.hpp"
+#include "integrators/team_choice.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace clothsim {
+
+class ColouredXpbd {
+public:
+    // The colouring of `topology`'s springs, bends and hinges; nullopt when some element would need more than
+    // kMaxColours colours (a particle in more than about 32 elements of one kind: not a cloth), and the list
+    // path runs instead.
+    static std::optional<ColouredXpbd> for_topology(const Topology& topology);
+    static constexpr int kMaxColours = 64;
+
+    // One substep: predict with the external accelerations (gravity, wind, damping), project every element
+    // once colour by colour, motion = x' - x; the multipliers by element index in `multipliers` (for
+    // xpbd_residual). `threads` (0: one per core, or one alone while that is faster: team_choice.hpp) share each
+    // colour; the result is the same for any thread count.
+    void step(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
+              double h, int threads, XpbdMultipliers& multipliers);
+    // The threads the last substep ran on.
+    int last_threads() const { return last_threads_; }
+
+    // Each kind's elements in colour order (indices into topology.springs, .bends, .hinges), and where each
+    // colour begins in it (colours + 1 entries).
+    struct Colours {
+        std::vector<std::uint32_t> order;
+        std::vector<std::uint32_t> begin;
+        int count() const { return static_cast<int>(begin.size()) - 1; }
+    };
+    const Colours& springs() const { return springs_; }
+    const Colours& bends() const { return bends_; }
+    const Colours& hinges() const { return hinges_; }
+
+private:
+    ColouredXpbd() = default;
+    Colours springs_, bends_, hinges_;
+    DVec3Array a_, start_;
+    Vec3Array wind_;
+    std::vector<double> violation_;  // per piece of a colour: its sum of C^2
+    TeamChoice team_choice_;
+    int last_threads_ = 1;
+};
+
+}  // namespace clothsim

@@ -1,5 +1,6 @@
 #include "integrators/coloured_xpbd.hpp"
 
+#include "integrators/fast_solver.hpp"
 #include "integrators/work_team.hpp"
 #include "integrators/xpbd_projection.hpp"
 #include "model/forces.hpp"
@@ -9,6 +10,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <immintrin.h>
 
 namespace clothsim {
 namespace {
@@ -40,7 +42,188 @@ std::optional<ColouredXpbd::Colours> colour(std::size_t count, std::size_t parti
     return out;
 }
 
+// Eight elements of one colour at a time with AVX-512: their particles gathered, the projection of
+// xpbd_projection.hpp computed lane by lane in the same order of operations (so the same bits), the particles
+// and multipliers scattered back where the element is projected (k != 0, and for a spring a length over
+// 1e-12). A colour's elements share no particle, so the eight never write the same place. Each returns the
+// sum of C^2 over [begin, end) added element by element in order, as the scalar loop adds it; the elements
+// past the last whole eight run the scalar projection.
+
+// base[index] for eight indices (the masked form: GCC 12 warns that the plain form's undefined source is
+// used uninitialised, as it does for the plain sqrt and conversion).
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m512d gather(const double* base, __m256i index) {
+    return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xFF, index, base, 8);
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m512d gather_wide(const float* base, __m256i index) {
+    return _mm512_maskz_cvtps_pd(0xFF, _mm256_i32gather_ps(base, index, 4));
+}
+// -v, as the scalar unary minus: the sign bit flipped (AVX-512F has no floating-point xor).
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m512d negate(__m512d v) {
+    return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(v), _mm512_set1_epi64(std::int64_t(1) << 63)));
+}
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m256i load8(const std::int32_t* p) {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+
 }  // namespace
+
+// One spring of the colour pass (entry e of the colour order), as project_spring.
+inline double ColouredXpbd::spring_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const {
+    const SpringData& d = spring_data_;
+    multipliers.spring[springs_.order[e]] = 0.0;  // until projected (the step does not clear them)
+    if (d.k[e] == 0.0) return 0.0;
+    const std::size_t ia = static_cast<std::size_t>(d.a[e]), ib = static_cast<std::size_t>(d.b[e]);
+    const double wa = state.inverse_mass[ia], wb = state.inverse_mass[ib];
+    const glm::dvec3 dv = state.position.get(ib) - state.position.get(ia);
+    const double length = std::sqrt((dv.x * dv.x + dv.y * dv.y) + dv.z * dv.z);
+    if (!(length > 1e-12)) return 0.0;
+    const double c = length - d.rest[e];
+    const double lambda = -c / ((wa + wb) + d.alpha[e]);
+    multipliers.spring[springs_.order[e]] = lambda;
+    const double g = lambda / length;
+    state.position.add(ia, dv * -(wa * g));
+    state.position.add(ib, dv * (wb * g));
+    return c * c;
+}
+
+// One hinge of the colour pass, as project_hinge.
+inline double ColouredXpbd::hinge_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const {
+    const HingeData& d = hinge_data_;
+    multipliers.hinge[hinges_.order[e]] = glm::dvec3(0.0);  // until projected (the step does not clear them)
+    if (d.k[e] == 0.0) return 0.0;
+    std::size_t v[4];
+    double w = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        v[i] = static_cast<std::size_t>(d.v[i][e]);
+        w += double(state.inverse_mass[v[i]]) * d.c[i][e] * d.c[i][e];
+    }
+    const glm::dvec3 o = state.position.get(v[0]);
+    const glm::dvec3 c = d.c[1][e] * (state.position.get(v[1]) - o) + d.c[2][e] * (state.position.get(v[2]) - o) +
+                         d.c[3][e] * (state.position.get(v[3]) - o);
+    const glm::dvec3 lambda = c * (-1.0 / (w + d.alpha[e]));
+    multipliers.hinge[hinges_.order[e]] = lambda;
+    for (int i = 0; i < 4; ++i) state.position.add(v[i], (double(state.inverse_mass[v[i]]) * d.c[i][e]) * lambda);
+    return (c.x * c.x + c.y * c.y) + c.z * c.z;
+}
+
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) double ColouredXpbd::springs_avx512(
+    State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const {
+    const SpringData& d = spring_data_;
+    double* x = state.position.x.data();
+    double* y = state.position.y.data();
+    double* z = state.position.z.data();
+    const float* w = state.inverse_mass.data();
+    double* lambdas = multipliers.spring.data();
+    const std::int32_t* order = reinterpret_cast<const std::int32_t*>(springs_.order.data());
+    const __m512d zero = _mm512_setzero_pd(), shortest = _mm512_set1_pd(1e-12);
+    double violation = 0.0;
+    std::uint32_t e = begin;
+    // Two batches of eight at once, every gather before any scatter: a gather waits for the scatters before it
+    // (the core cannot tell that they touch other particles), so one batch at a time runs its gathers, square
+    // root and divides back to back; two overlap.
+    constexpr std::uint32_t kBatches = 2;
+    for (; e + 8 * kBatches <= end; e += 8 * kBatches) {
+        __m256i va[kBatches], vb[kBatches];
+        __m512d xa[kBatches], ya[kBatches], za[kBatches], xb[kBatches], yb[kBatches], zb[kBatches];
+        __m512d dx[kBatches], dy[kBatches], dz[kBatches], c[kBatches], lambda[kBatches], ta[kBatches], tb[kBatches];
+        __mmask8 on[kBatches];
+        for (std::uint32_t u = 0; u < kBatches; ++u) {
+            const std::uint32_t f = e + 8 * u;
+            va[u] = load8(d.a.data() + f), vb[u] = load8(d.b.data() + f);
+            xa[u] = gather(x, va[u]), ya[u] = gather(y, va[u]), za[u] = gather(z, va[u]);
+            xb[u] = gather(x, vb[u]), yb[u] = gather(y, vb[u]), zb[u] = gather(z, vb[u]);
+        }
+        for (std::uint32_t u = 0; u < kBatches; ++u) {
+            const std::uint32_t f = e + 8 * u;
+            const __m512d wa = gather_wide(w, va[u]), wb = gather_wide(w, vb[u]);
+            dx[u] = _mm512_sub_pd(xb[u], xa[u]), dy[u] = _mm512_sub_pd(yb[u], ya[u]), dz[u] = _mm512_sub_pd(zb[u], za[u]);
+            const __m512d length = _mm512_maskz_sqrt_pd(
+                0xFF, _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx[u], dx[u]), _mm512_mul_pd(dy[u], dy[u])),
+                                    _mm512_mul_pd(dz[u], dz[u])));
+            on[u] = _mm512_cmp_pd_mask(_mm512_loadu_pd(d.k.data() + f), zero, _CMP_NEQ_UQ) &
+                    _mm512_cmp_pd_mask(length, shortest, _CMP_GT_OQ);
+            c[u] = _mm512_sub_pd(length, _mm512_loadu_pd(d.rest.data() + f));
+            lambda[u] = _mm512_div_pd(negate(c[u]), _mm512_add_pd(_mm512_add_pd(wa, wb), _mm512_loadu_pd(d.alpha.data() + f)));
+            const __m512d g = _mm512_div_pd(lambda[u], length);
+            ta[u] = negate(_mm512_mul_pd(wa, g)), tb[u] = _mm512_mul_pd(wb, g);
+        }
+        for (std::uint32_t u = 0; u < kBatches; ++u) {
+            const __mmask8 m = on[u];
+            _mm512_mask_i32scatter_pd(x, m, va[u], _mm512_add_pd(xa[u], _mm512_mul_pd(dx[u], ta[u])), 8);
+            _mm512_mask_i32scatter_pd(y, m, va[u], _mm512_add_pd(ya[u], _mm512_mul_pd(dy[u], ta[u])), 8);
+            _mm512_mask_i32scatter_pd(z, m, va[u], _mm512_add_pd(za[u], _mm512_mul_pd(dz[u], ta[u])), 8);
+            _mm512_mask_i32scatter_pd(x, m, vb[u], _mm512_add_pd(xb[u], _mm512_mul_pd(dx[u], tb[u])), 8);
+            _mm512_mask_i32scatter_pd(y, m, vb[u], _mm512_add_pd(yb[u], _mm512_mul_pd(dy[u], tb[u])), 8);
+            _mm512_mask_i32scatter_pd(z, m, vb[u], _mm512_add_pd(zb[u], _mm512_mul_pd(dz[u], tb[u])), 8);
+            // Every lane's multiplier, 0 where the element is not projected (as the list order leaves it).
+            _mm512_i32scatter_pd(lambdas, load8(order + e + 8 * u), _mm512_maskz_mov_pd(m, lambda[u]), 8);
+            alignas(64) double cc[8];
+            _mm512_store_pd(cc, _mm512_mul_pd(c[u], c[u]));
+            for (int l = 0; l < 8; ++l) {
+                if (m & (1u << l)) violation += cc[l];
+            }
+        }
+    }
+    for (; e < end; ++e) violation += spring_one(state, e, multipliers);
+    return violation;
+}
+
+// hinge_difference (forces.hpp) of one coordinate: relative to v[0], c1 (q1 - q0) + c2 (q2 - q0) + c3 (q3 - q0),
+// summed left to right.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static inline __m512d hinge_difference8(const __m512d* q,
+                                                                                            const __m512d* c) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(c[1], _mm512_sub_pd(q[1], q[0])),
+                                       _mm512_mul_pd(c[2], _mm512_sub_pd(q[2], q[0]))),
+                         _mm512_mul_pd(c[3], _mm512_sub_pd(q[3], q[0])));
+}
+
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) double ColouredXpbd::hinges_avx512(
+    State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const {
+    const HingeData& d = hinge_data_;
+    double* x = state.position.x.data();
+    double* y = state.position.y.data();
+    double* z = state.position.z.data();
+    const float* w = state.inverse_mass.data();
+    glm::dvec3* lambdas = multipliers.hinge.data();
+    const __m512d zero = _mm512_setzero_pd(), minus_one = _mm512_set1_pd(-1.0);
+    double violation = 0.0;
+    std::uint32_t e = begin;
+    // One batch at a time: two at once (as springs_avx512) measured no faster here, the registers spill; a
+    // hinge's sixteen gathers and twelve scatters per eight are what it waits for.
+    for (; e + 8 <= end; e += 8) {
+        __m256i vi[4];
+        __m512d px[4], py[4], pz[4], ci[4], t[4];
+        __m512d sum_w = zero;
+        for (int i = 0; i < 4; ++i) {
+            vi[i] = load8(d.v[i].data() + e);
+            px[i] = gather(x, vi[i]), py[i] = gather(y, vi[i]), pz[i] = gather(z, vi[i]);
+            ci[i] = _mm512_loadu_pd(d.c[i].data() + e);
+            const __m512d wi = gather_wide(w, vi[i]);
+            sum_w = _mm512_add_pd(sum_w, _mm512_mul_pd(_mm512_mul_pd(wi, ci[i]), ci[i]));
+            t[i] = _mm512_mul_pd(wi, ci[i]);
+        }
+        const __mmask8 on = _mm512_cmp_pd_mask(_mm512_loadu_pd(d.k.data() + e), zero, _CMP_NEQ_UQ);
+        const __m512d cx = hinge_difference8(px, ci), cy = hinge_difference8(py, ci), cz = hinge_difference8(pz, ci);
+        const __m512d scale = _mm512_div_pd(minus_one, _mm512_add_pd(sum_w, _mm512_loadu_pd(d.alpha.data() + e)));
+        const __m512d lambda_x = _mm512_mul_pd(cx, scale), lambda_y = _mm512_mul_pd(cy, scale),
+                      lambda_z = _mm512_mul_pd(cz, scale);
+        for (int i = 0; i < 4; ++i) {
+            _mm512_mask_i32scatter_pd(x, on, vi[i], _mm512_add_pd(px[i], _mm512_mul_pd(t[i], lambda_x)), 8);
+            _mm512_mask_i32scatter_pd(y, on, vi[i], _mm512_add_pd(py[i], _mm512_mul_pd(t[i], lambda_y)), 8);
+            _mm512_mask_i32scatter_pd(z, on, vi[i], _mm512_add_pd(pz[i], _mm512_mul_pd(t[i], lambda_z)), 8);
+        }
+        alignas(64) double lx[8], ly[8], lz[8], cc[8];
+        _mm512_store_pd(lx, lambda_x), _mm512_store_pd(ly, lambda_y), _mm512_store_pd(lz, lambda_z);
+        _mm512_store_pd(cc, _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(cx, cx), _mm512_mul_pd(cy, cy)), _mm512_mul_pd(cz, cz)));
+        for (int l = 0; l < 8; ++l) {
+            const bool projected = on & (1u << l);
+            lambdas[hinges_.order[e + static_cast<std::uint32_t>(l)]] = projected ? glm::dvec3(lx[l], ly[l], lz[l]) : glm::dvec3(0.0);
+            if (projected) violation += cc[l];
+        }
+    }
+    for (; e < end; ++e) violation += hinge_one(state, e, multipliers);
+    return violation;
+}
 
 std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology) {
     std::size_t n = 0;  // the particles the elements reach
@@ -60,13 +243,51 @@ std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology)
     out.springs_ = std::move(*springs);
     out.bends_ = std::move(*bends);
     out.hinges_ = std::move(*hinges);
+    // The data in colour order.
+    SpringData& sd = out.spring_data_;
+    for (std::uint32_t j : out.springs_.order) {
+        const Spring& s = topology.springs[j];
+        sd.a.push_back(static_cast<std::int32_t>(s.a));
+        sd.b.push_back(static_cast<std::int32_t>(s.b));
+        sd.rest.push_back(static_cast<double>(s.rest_length));
+    }
+    HingeData& hd = out.hinge_data_;
+    for (std::uint32_t j : out.hinges_.order) {
+        for (int i = 0; i < 4; ++i) {
+            hd.v[static_cast<std::size_t>(i)].push_back(static_cast<std::int32_t>(topology.hinges[j].v[static_cast<std::size_t>(i)]));
+            hd.c[static_cast<std::size_t>(i)].push_back(double(topology.hinges[j].c[static_cast<std::size_t>(i)]));
+        }
+    }
     return out;
 }
+
+void ColouredXpbd::set_stiffness(const Topology& topology, const SpringSettings& springs) {
+    spring_data_.k.clear();
+    for (std::uint32_t j : springs_.order) spring_data_.k.push_back(stiffness_of(springs, topology.springs[j]));
+    hinge_data_.k.clear();
+    for (std::uint32_t j : hinges_.order) hinge_data_.k.push_back(stiffness_of(springs, topology.hinges[j]));
+    alpha_h_ = 0.0;
+}
+
+// alpha~ = 1 / (k w h^2) for the substep h, computed as the list order computes it.
+void ColouredXpbd::set_substep(double h) {
+    if (h == alpha_h_) return;
+    auto fill = [h](const std::vector<double>& k, std::vector<double>& alpha) {
+        alpha.resize(k.size());
+        for (std::size_t e = 0; e < k.size(); ++e) alpha[e] = 1.0 / (k[e] * h * h);
+    };
+    fill(spring_data_.k, spring_data_.alpha);
+    fill(hinge_data_.k, hinge_data_.alpha);
+    alpha_h_ = h;
+}
+
+
 
 void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& topology, const SpringSettings& springs,
                         double h, int threads, XpbdMultipliers& multipliers) {
     const std::size_t n = state.size();
     state.substep = h;
+    set_substep(h);
     const bool automatic = threads == 0;
     const int wanted = std::clamp(threads > 0 ? threads : WorkTeam::cores(), 1, WorkTeam::kMaxThreads);
     int team = wanted;
@@ -84,14 +305,19 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
         state.position.add(i, state.motion.get(i) + a_.get(i) * (h * h));  // x + h (v + h a)
     }
 
-    multipliers.spring.assign(topology.springs.size(), 0.0);
+    // Every element's multiplier is written in its colour (0 where it is not projected), so they are not
+    // cleared first; the bends' are (a mesh cloth has none).
+    multipliers.spring.resize(topology.springs.size());
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
-    multipliers.hinge.assign(topology.hinges.size(), glm::dvec3(0.0));
+    multipliers.hinge.resize(topology.hinges.size());
     // Each colour in pieces of kPiece elements (small enough that a descheduled thread holds up little:
     // work_team.hpp); each piece's sum of C^2 in its own slot, summed in piece order: the same for any team.
+    // With the AVX-512 kernel (FastSolver's choice, so the tests run every kernel the CPU has), springs and
+    // hinges eight at a time; the same bits as the scalar loop.
     constexpr std::uint32_t kPiece = 512;
+    const bool wide = FastSolver::kernel() == FastKernel::Avx512;
     double violation2 = 0.0;
-    auto project = [&](const Colours& colours, auto&& one) {
+    auto project = [&](const Colours& colours, auto&& piece_of) {
         for (int c = 0; c < colours.count(); ++c) {
             const std::uint32_t first = colours.begin[static_cast<std::size_t>(c)];
             const std::uint32_t last = colours.begin[static_cast<std::size_t>(c) + 1];
@@ -99,25 +325,31 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
             violation_.assign(static_cast<std::size_t>(pieces), 0.0);
             work_team.run(team, pieces, [&](int piece, int) {
                 const std::uint32_t begin = first + static_cast<std::uint32_t>(piece) * kPiece;
-                const std::uint32_t end = std::min(last, begin + kPiece);
-                double v = 0.0;
-                for (std::uint32_t e = begin; e < end; ++e) v += one(colours.order[e]);
-                violation_[static_cast<std::size_t>(piece)] = v;
+                violation_[static_cast<std::size_t>(piece)] = piece_of(begin, std::min(last, begin + kPiece));
             });
             for (double v : violation_) violation2 += v;
         }
     };
-    project(springs_, [&](std::uint32_t j) {
-        const double k = stiffness_of(springs, topology.springs[j]);
-        return k != 0.0 ? project_spring(state, topology.springs[j], k, h, multipliers.spring[j]) : 0.0;
+    project(springs_, [&](std::uint32_t begin, std::uint32_t end) {
+        if (wide) return springs_avx512(state, begin, end, multipliers);
+        double v = 0.0;
+        for (std::uint32_t e = begin; e < end; ++e) v += spring_one(state, e, multipliers);
+        return v;
     });
-    project(bends_, [&](std::uint32_t j) {
-        const double k = stiffness_of(springs, topology.bends[j]);
-        return k != 0.0 ? project_bend(state, topology.bends[j], k, h, multipliers.bend[j]) : 0.0;
+    project(bends_, [&](std::uint32_t begin, std::uint32_t end) {  // a grid's: a mesh cloth has none
+        double v = 0.0;
+        for (std::uint32_t e = begin; e < end; ++e) {
+            const std::uint32_t j = bends_.order[e];
+            const double k = stiffness_of(springs, topology.bends[j]);
+            if (k != 0.0) v += project_bend(state, topology.bends[j], k, h, multipliers.bend[j]);
+        }
+        return v;
     });
-    project(hinges_, [&](std::uint32_t j) {
-        const double k = stiffness_of(springs, topology.hinges[j]);
-        return k != 0.0 ? project_hinge(state, topology.hinges[j], k, h, multipliers.hinge[j]) : 0.0;
+    project(hinges_, [&](std::uint32_t begin, std::uint32_t end) {
+        if (wide) return hinges_avx512(state, begin, end, multipliers);
+        double v = 0.0;
+        for (std::uint32_t e = begin; e < end; ++e) v += hinge_one(state, e, multipliers);
+        return v;
     });
 
     for (std::size_t i = 0; i < n; ++i) {

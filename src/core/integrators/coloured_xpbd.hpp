@@ -18,6 +18,7 @@
 #include "integrators/integrators.hpp"
 #include "integrators/team_choice.hpp"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -31,6 +32,9 @@ public:
     // path runs instead.
     static std::optional<ColouredXpbd> for_topology(const Topology& topology);
     static constexpr int kMaxColours = 64;
+
+    // Every element's k w from the settings; call after the springs' settings change.
+    void set_stiffness(const Topology& topology, const SpringSettings& springs);
 
     // One substep: predict with the external accelerations (gravity, wind, damping), project every element
     // once colour by colour, motion = x' - x; the multipliers by element index in `multipliers` (for
@@ -54,7 +58,27 @@ public:
 
 private:
     ColouredXpbd() = default;
+    void set_substep(double h);
+    // One element of a colour pass (entry e of the colour order), and a run [begin, end) of them eight at a time
+    // with AVX-512; each returns its sum of C^2, added element by element.
+    double spring_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const;
+    double hinge_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const;
+    double springs_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
+    double hinges_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
+
     Colours springs_, bends_, hinges_;
+    // The springs' and hinges' data in colour order (entry e is element order[e]), what a colour's pass reads
+    // contiguously: particles, rest lengths and weights, k w (0: not projected) and alpha~ = 1 / (k w h^2).
+    struct SpringData {
+        std::vector<std::int32_t> a, b;
+        std::vector<double> rest, k, alpha;
+    } spring_data_;
+    struct HingeData {
+        std::array<std::vector<std::int32_t>, 4> v;
+        std::array<std::vector<double>, 4> c;
+        std::vector<double> k, alpha;
+    } hinge_data_;
+    double alpha_h_ = 0.0;  // the substep alpha is for (0: not set)
     DVec3Array a_, start_;
     Vec3Array wind_;
     std::vector<double> violation_;  // per piece of a colour: its sum of C^2

@@ -96,6 +96,7 @@ void xpbd_substep(IntegratorContext& c) {
         if (caches.grid_xpbd) caches.grid_xpbd->set_stiffness(c.topology, c.settings.springs);
         caches.coloured_xpbd.reset();
         if (!caches.grid_xpbd) caches.coloured_xpbd = ColouredXpbd::for_topology(c.topology);
+        if (caches.coloured_xpbd) caches.coloured_xpbd->set_stiffness(c.topology, c.settings.springs);
         caches.grid_xpbd_current = true;
     }
     caches.grid_xpbd_ran = fast && caches.grid_xpbd.has_value();

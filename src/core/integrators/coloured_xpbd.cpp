@@ -67,43 +67,26 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) inline __m256i load8(const 
 
 }  // namespace
 
-// One spring of the colour pass (entry e of the colour order), as project_spring.
+// One spring of the colour pass (entry e of the colour order), by project_spring on its stored data.
 inline double ColouredXpbd::spring_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const {
     const SpringData& d = spring_data_;
-    multipliers.spring[springs_.order[e]] = 0.0;  // until projected (the step does not clear them)
+    double& lambda = multipliers.spring[springs_.order[e]];
+    lambda = 0.0;  // until projected (the step does not clear them)
     if (d.k[e] == 0.0) return 0.0;
-    const std::size_t ia = static_cast<std::size_t>(d.a[e]), ib = static_cast<std::size_t>(d.b[e]);
-    const double wa = state.inverse_mass[ia], wb = state.inverse_mass[ib];
-    const glm::dvec3 dv = state.position.get(ib) - state.position.get(ia);
-    const double length = std::sqrt((dv.x * dv.x + dv.y * dv.y) + dv.z * dv.z);
-    if (!(length > 1e-12)) return 0.0;
-    const double c = length - d.rest[e];
-    const double lambda = -c / ((wa + wb) + d.alpha[e]);
-    multipliers.spring[springs_.order[e]] = lambda;
-    const double g = lambda / length;
-    state.position.add(ia, dv * -(wa * g));
-    state.position.add(ib, dv * (wb * g));
-    return c * c;
+    return project_spring(state, static_cast<std::size_t>(d.a[e]), static_cast<std::size_t>(d.b[e]), d.rest[e],
+                          d.alpha[e], lambda);
 }
 
-// One hinge of the colour pass, as project_hinge.
+// One hinge of the colour pass, by project_hinge on its stored data.
 inline double ColouredXpbd::hinge_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const {
     const HingeData& d = hinge_data_;
-    multipliers.hinge[hinges_.order[e]] = glm::dvec3(0.0);  // until projected (the step does not clear them)
+    glm::dvec3& lambda = multipliers.hinge[hinges_.order[e]];
+    lambda = glm::dvec3(0.0);  // until projected (the step does not clear them)
     if (d.k[e] == 0.0) return 0.0;
-    std::size_t v[4];
-    double w = 0.0;
-    for (int i = 0; i < 4; ++i) {
-        v[i] = static_cast<std::size_t>(d.v[i][e]);
-        w += double(state.inverse_mass[v[i]]) * d.c[i][e] * d.c[i][e];
-    }
-    const glm::dvec3 o = state.position.get(v[0]);
-    const glm::dvec3 c = d.c[1][e] * (state.position.get(v[1]) - o) + d.c[2][e] * (state.position.get(v[2]) - o) +
-                         d.c[3][e] * (state.position.get(v[3]) - o);
-    const glm::dvec3 lambda = c * (-1.0 / (w + d.alpha[e]));
-    multipliers.hinge[hinges_.order[e]] = lambda;
-    for (int i = 0; i < 4; ++i) state.position.add(v[i], (double(state.inverse_mass[v[i]]) * d.c[i][e]) * lambda);
-    return (c.x * c.x + c.y * c.y) + c.z * c.z;
+    std::array<std::size_t, 4> v;
+    std::array<double, 4> c;
+    for (std::size_t i = 0; i < 4; ++i) v[i] = static_cast<std::size_t>(d.v[i][e]), c[i] = d.c[i][e];
+    return project_hinge(state, v, c, d.alpha[e], lambda);
 }
 
 __attribute__((target("avx512f,avx512vl,avx2,fma"))) double ColouredXpbd::springs_avx512(

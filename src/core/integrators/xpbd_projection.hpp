@@ -9,23 +9,30 @@
 
 #include "model/forces.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace clothsim {
 
-// A spring C = |x_b - x_a| - L0 with compliance alpha~ = 1 / (k h^2): d_lambda = -C / (w_a + w_b + alpha~), and
-// x_a -= w_a lambda n, x_b += w_b lambda n with n = d / |d|, computed as lambda / |d| times d.
-inline double project_spring(State& state, const Spring& s, double k, double h, double& lambda) {
-    const double wa = state.inverse_mass[s.a], wb = state.inverse_mass[s.b];
-    const glm::dvec3 d = state.position.get(s.b) - state.position.get(s.a);
+// A spring from particle a to b, C = |x_b - x_a| - L0, with compliance alpha~ = 1 / (k h^2):
+// d_lambda = -C / (w_a + w_b + alpha~), and x_a -= w_a lambda n, x_b += w_b lambda n with n = d / |d|, computed as
+// lambda / |d| times d. Leaves `lambda` alone where the spring has no length to project along.
+inline double project_spring(State& state, std::size_t a, std::size_t b, double rest_length, double alpha,
+                             double& lambda) {
+    const double wa = state.inverse_mass[a], wb = state.inverse_mass[b];
+    const glm::dvec3 d = state.position.get(b) - state.position.get(a);
     const double length = std::sqrt((d.x * d.x + d.y * d.y) + d.z * d.z);
     if (!(length > 1e-12)) return 0.0;
-    const double c = length - static_cast<double>(s.rest_length);
-    lambda = -c / ((wa + wb) + 1.0 / (k * h * h));
+    const double c = length - rest_length;
+    lambda = -c / ((wa + wb) + alpha);
     const double g = lambda / length;
-    state.position.add(s.a, d * -(wa * g));
-    state.position.add(s.b, d * (wb * g));
+    state.position.add(a, d * -(wa * g));
+    state.position.add(b, d * (wb * g));
     return c * c;
+}
+inline double project_spring(State& state, const Spring& s, double k, double h, double& lambda) {
+    return project_spring(state, s.a, s.b, static_cast<double>(s.rest_length), 1.0 / (k * h * h), lambda);
 }
 
 // A bend: the vector constraint C = x_a - 2 x_m + x_b with gradients I, -2 I, I:
@@ -40,16 +47,21 @@ inline double project_bend(State& state, const Bend& b, double k, double h, glm:
     return (c.x * c.x + c.y * c.y) + c.z * c.z;
 }
 
-// A hinge: the vector constraint C = sum_i c_i x_i with gradients c_i I: d_lambda = -C / (sum_i w_i c_i^2 + 1 / (k h^2)).
-inline double project_hinge(State& state, const Hinge& hinge, double k, double h, glm::dvec3& lambda) {
+// A hinge on particles v with weights c: the vector constraint C = sum_i c_i x_i with gradients c_i I:
+// d_lambda = -C / (sum_i w_i c_i^2 + alpha~).
+inline double project_hinge(State& state, const std::array<std::size_t, 4>& v, const std::array<double, 4>& c,
+                            double alpha, glm::dvec3& lambda) {
     double w = 0.0;
-    for (int i = 0; i < 4; ++i) w += double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i]) * double(hinge.c[i]);
-    const glm::dvec3 c = hinge_difference(state.position, hinge);
-    lambda = c * (-1.0 / (w + 1.0 / (k * h * h)));
-    for (int i = 0; i < 4; ++i) {
-        state.position.add(hinge.v[i], (double(state.inverse_mass[hinge.v[i]]) * double(hinge.c[i])) * lambda);
-    }
-    return (c.x * c.x + c.y * c.y) + c.z * c.z;
+    for (int i = 0; i < 4; ++i) w += double(state.inverse_mass[v[i]]) * c[i] * c[i];
+    const glm::dvec3 C = hinge_difference(state.position, v, c);
+    lambda = C * (-1.0 / (w + alpha));
+    for (int i = 0; i < 4; ++i) state.position.add(v[i], (double(state.inverse_mass[v[i]]) * c[i]) * lambda);
+    return (C.x * C.x + C.y * C.y) + C.z * C.z;
+}
+inline double project_hinge(State& state, const Hinge& hinge, double k, double h, glm::dvec3& lambda) {
+    return project_hinge(state, {hinge.v[0], hinge.v[1], hinge.v[2], hinge.v[3]},
+                         {double(hinge.c[0]), double(hinge.c[1]), double(hinge.c[2]), double(hinge.c[3])},
+                         1.0 / (k * h * h), lambda);
 }
 
 }  // namespace clothsim

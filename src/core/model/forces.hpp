@@ -1,6 +1,9 @@
 // Force stages of a time step. Each adds its contribution (N) to `force`; none clears it.
 #pragma once
 
+#include <array>
+#include <cstddef>
+
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
@@ -60,12 +63,16 @@ inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
 inline float stiffness_of(const SpringSettings& springs, const Hinge& h) {
     return springs.bending.x * h.weight_u + springs.bending.y * h.weight_v;
 }
-// A hinge's sum_i c_i x_i (spring.hpp), in double.
-inline glm::dvec3 hinge_difference(const DVec3Array& position, const Hinge& h) {
+// A hinge's sum_i c_i x_i (spring.hpp), in double, for particles v and weights c.
+inline glm::dvec3 hinge_difference(const DVec3Array& position, const std::array<std::size_t, 4>& v,
+                                   const std::array<double, 4>& c) {
     // Relative to v[0], so the sum keeps the precision of the small differences (the weights sum to 0).
-    const glm::dvec3 o = position.get(h.v[0]);
-    return double(h.c[1]) * (position.get(h.v[1]) - o) + double(h.c[2]) * (position.get(h.v[2]) - o) +
-           double(h.c[3]) * (position.get(h.v[3]) - o);
+    const glm::dvec3 o = position.get(v[0]);
+    return c[1] * (position.get(v[1]) - o) + c[2] * (position.get(v[2]) - o) + c[3] * (position.get(v[3]) - o);
+}
+inline glm::dvec3 hinge_difference(const DVec3Array& position, const Hinge& h) {
+    return hinge_difference(position, {h.v[0], h.v[1], h.v[2], h.v[3]},
+                            {double(h.c[0]), double(h.c[1]), double(h.c[2]), double(h.c[3])});
 }
 // The second difference x_a - 2 x_m + x_b of a bend, in double: (x_a - x_m) + (x_b - x_m).
 inline glm::dvec3 bend_difference(const DVec3Array& position, const Bend& b) {

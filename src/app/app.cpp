@@ -989,7 +989,7 @@ int run_app(const Scene& scene, const AppOptions& options) {
     const bool scripted = options.frames.has_value();
     std::optional<Window> window;
     try {
-        window.emplace(options.size, "clothsim - " + scene.name, !scripted);
+        window.emplace(options.size, "clothsim - " + scene.name, !scripted, options.samples);
     } catch (const WindowError& e) {
         std::cerr << "clothsim: error: " << e.what() << "\n";
         return kExitBadInput;
@@ -1021,6 +1021,11 @@ int run_app(const Scene& scene, const AppOptions& options) {
     policy.safety = options.safety;
     policy.guard = true;
     AppState app(scene, options.scene_source, policy);
+    app.display = {window->renderer(), window->samples(), window->software(), window->samples_chosen_for_software()};
+    if (app.display.samples_auto_off) {
+        std::cout << "clothsim: anti-aliasing off on the software renderer " << app.display.renderer
+                  << " (--samples 4 turns it on)\n";
+    }
     start_panel(app, options);
     if (!scripted) {  // scripted runs leave the user's recent files and settings alone
         app.recent = RecentFiles::from_config();

@@ -30,6 +30,7 @@ struct AppOptions {
     // a script can measure what the window costs (docs/PERFORMANCE.md, "Threads under load").
     std::string frame_times;
     ViewSettings view;       // the View section's start values (--view)
+    int samples = -1;        // anti-aliasing samples per pixel (--samples; -1: 4, none on a software renderer)
     bool show_panel = true;
     // Auto substeps (on in interactive runs; scripted runs step exactly what the scene says unless asked).
     bool auto_substeps = true;

@@ -164,6 +164,13 @@ struct AppState {
     bool show_panel = true;
     float panel_width = kPanelWidth;  // window coordinates at content scale 1; the user drags the panel's edge
     bool vsync = true;
+    // The window's OpenGL renderer and anti-aliasing, as the View section shows them (window.hpp).
+    struct Display {
+        std::string renderer;
+        int samples = 0;
+        bool software = false;
+        bool samples_auto_off = false;  // auto chose no multisampling for a software renderer
+    } display;
     Stats stats;
     std::optional<Grab> grab;
     std::optional<ObjectDrag> object_drag;

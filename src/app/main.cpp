@@ -142,6 +142,11 @@ void add_flags(CLI::App& app, CommandLine& cl) {
         ->transform(number_check({.min_excluded = true, .meaning = "wall seconds"}))
         ->excludes(frames)
         ->excludes(headless_flag);
+    app.add_option("--samples", cl.app_options.samples,
+                   "App: anti-aliasing samples per pixel, 0 (off) to 16 (default: 4, or 0 on a software OpenGL "
+                   "renderer such as llvmpipe)")
+        ->transform(number_check({.whole = true, .min = 0, .max = 16, .meaning = "samples per pixel"}))
+        ->excludes(headless_flag);
     app.add_option("--size", cl.size_text, "App: window size WxH in screen coordinates (default 1280x720)");
     app.add_option("--view", cl.view_items,
                    "App: start with these view options (comma-separated): wireframe, springs=kind, springs=strain, "

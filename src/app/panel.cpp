@@ -844,6 +844,17 @@ void view_section(AppState& app, PanelRequests& requests) {
     ImGui::Checkbox("fabric texture", &app.view.texture);
     ImGui::Checkbox("shadows", &app.view.shadows);
     ImGui::Checkbox("vsync", &app.vsync);
+    // The anti-aliasing the window got: chosen at launch (--samples), as a window's samples cannot change.
+    if (app.display.samples > 0) {
+        ImGui::TextDisabled("anti-aliasing: %dx MSAA", app.display.samples);
+    } else {
+        ImGui::TextDisabled(app.display.samples_auto_off ? "anti-aliasing: off (software renderer)" : "anti-aliasing: off");
+    }
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("OpenGL renderer: %s\nSet at launch with --samples N (0 to 16); by default 4, or none on a "
+                          "software renderer, which rasterises every sample on the CPU.",
+                          app.display.renderer.c_str());
+    }
     if (ImGui::Button("Frame cloth (F)")) requests.frame_camera = true;
     ImGui::SameLine();
     if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;

@@ -35,7 +35,16 @@ static void keep_gl_driver_loaded() { dl_iterate_phdr(pin_dri_module, nullptr); 
 static void keep_gl_driver_loaded() {}
 #endif
 
-Window::Window(glm::ivec2 size, const std::string& title, bool vsync) {
+// Renderers that rasterise on the CPU, by their GL_RENDERER strings: Mesa's llvmpipe and softpipe (and the
+// classic "Software Rasterizer"), Google's SwiftShader.
+bool is_software_renderer(const std::string& renderer) {
+    for (const char* name : {"llvmpipe", "softpipe", "Software Rasterizer", "SwiftShader"}) {
+        if (renderer.find(name) != std::string::npos) return true;
+    }
+    return false;
+}
+
+Window::Window(glm::ivec2 size, const std::string& title, bool vsync, int samples) {
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit()) {
         throw WindowError("cannot open a window: " + g_last_glfw_error +
@@ -47,15 +56,29 @@ Window::Window(glm::ivec2 size, const std::string& title, bool vsync) {
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
     glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
-    // 4x MSAA when the display offers it; a display without multisampled visuals still gets a window.
-    for (int samples : {4, 0}) {
-        glfwWindowHint(GLFW_SAMPLES, samples);
+    // Hidden until its samples are settled: the renderer is known only once a context exists, and on a software
+    // renderer the automatic choice makes the window again without samples (never shown, so no window
+    // manager, screen reader or xdotool sees the first one).
+    glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
+    const bool automatic = samples == kAutoSamples;
+    open(size, title, automatic ? 4 : samples);
+    if (automatic && samples_ > 0 && software_) {
+        glfwDestroyWindow(window_);
+        window_ = nullptr;
+        open(size, title, 0);
+        auto_off_ = true;
+    }
+    glfwShowWindow(window_);
+    set_vsync(vsync);
+}
+
+void Window::open(glm::ivec2 size, const std::string& title, int samples) {
+    for (int tried : {samples, 0}) {
+        glfwWindowHint(GLFW_SAMPLES, tried);
         window_ = glfwCreateWindow(size.x, size.y, title.c_str(), nullptr, nullptr);
         keep_gl_driver_loaded();  // also when creation failed: the driver was loaded to try
-        if (window_) {
-            samples_ = samples;
-            break;
-        }
+        if (window_) break;
+        if (tried == 0) break;
     }
     if (!window_) {
         const std::string reason = g_last_glfw_error;
@@ -74,7 +97,13 @@ Window::Window(glm::ivec2 size, const std::string& title, bool vsync) {
                                    : std::string("nothing GLAD could load")) +
                           "); run clothsim --headless instead");
     }
-    set_vsync(vsync);
+    // What the framebuffer got, which a driver may round or ignore (GLFW_SAMPLES is a minimum hint).
+    GLint got = 0;
+    glGetIntegerv(GL_SAMPLES, &got);
+    samples_ = got;
+    const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    renderer_ = name ? name : "";
+    software_ = is_software_renderer(renderer_);
 }
 
 Window::~Window() {

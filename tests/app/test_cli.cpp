@@ -530,6 +530,9 @@ TEST_CASE("cli: app flags are checked before a window opens") {
     expect_bad_input({"--size", "10x10"}, {"[64, 8192]"});
     expect_bad_input({"--screenshot", "x.png"}, {"--frames"});
     expect_bad_input({"--frames", "0"}, {"--frames"});
+    expect_bad_input({"--samples", "17"}, {"--samples", "[0, 16]", "samples per pixel"});
+    expect_bad_input({"--samples", "2.5"}, {"--samples", "whole number"});
+    expect_bad_input({"--headless", "--samples", "4"}, {"--headless excludes --samples"});
 }
 
 // ---------------------------------------------------------------------------------------------------------

@@ -635,3 +635,37 @@ TEST_CASE("render --record: N frames, each a PNG of the window's size, numbered 
     CHECK_THAT(again.err, Contains("--record") && Contains("already holds a recording"));
     CHECK(!fs::exists(folder / "frame-000007.png"));
 }
+
+TEST_CASE("render anti-aliasing: none by default on a software renderer, said on stdout; --samples 4 multisamples") {
+    // The tests' windows open on Xvfb, whose OpenGL is Mesa's llvmpipe: a software renderer, where the default
+    // is no multisampling. With --samples 4 the edges are rasterised at the samples' positions, so the
+    // silhouettes' pixels differ from a single-sampled picture (llvmpipe reads back sample 0: about 950 pixels
+    // of drape-sphere differ, along the sphere's, the cloth's and the shadow's edges); the default draws the
+    // same picture as --samples 0, bit for bit.
+    const Screenshot& automatic = screenshot("drape-sphere", 1);
+    const Screenshot& four = screenshot("drape-sphere", 1, {"--samples", "4"});
+    const Screenshot& none = screenshot("drape-sphere", 1, {"--samples", "0"});
+    REQUIRE(usable(automatic));
+    REQUIRE(usable(four));
+    REQUIRE(usable(none));
+    CHECK_THAT(automatic.run.out, Contains("clothsim: anti-aliasing off on the software renderer llvmpipe") &&
+                                      Contains("(--samples 4 turns it on)"));
+    CHECK_THAT(four.run.out, !Contains("anti-aliasing"));
+    CHECK_THAT(none.run.out, !Contains("anti-aliasing"));
+    auto differing = [](const Image& a, const Image& b) {
+        long long n = 0;
+        for (int y = kViewRect.y0; y < kViewRect.y1; ++y) {
+            for (int x = kViewRect.x0; x < kViewRect.x1; ++x) {
+                const Rgb p = a.at(x, y), q = b.at(x, y);
+                n += std::abs(p.r - q.r) + std::abs(p.g - q.g) + std::abs(p.b - q.b) > 6 ? 1 : 0;
+            }
+        }
+        return n;
+    };
+    const long long by_default = differing(automatic.image, none.image), by_samples = differing(four.image, none.image);
+    INFO("pixels of the 3D view that differ from --samples 0: the default " << by_default << ", --samples 4 "
+                                                                             << by_samples);
+    CHECK(by_default == 0);
+    CHECK(by_samples > 300);
+    CHECK(by_samples < kViewRect.area() / 50);  // the edges, not the whole picture
+}

@@ -12,22 +12,39 @@
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 namespace clothsim {
 
 struct ElementGather {
-    // Particle i's elements are entry[begin[i] .. begin[i + 1]): element * 4 + slot, the element a spring
-    // index j (slot 0: end a, slot 1: end b) or springs + a hinge index (slot: which of its four particles).
-    std::vector<std::uint32_t> begin, entry;
+    // Particle i's terms are [begin[i], begin[i + 1]): it adds coefficient[k] * element_force[source[k]] for
+    // each k, in list order. element_force holds the springs' forces on their end a (j) and then the hinges'
+    // e = k sum_i c_i x_i (springs + h); a spring's coefficient is +1 at end a and -1 at end b (exact: the
+    // product is the force or its negation), a hinge's is -c_slot.
+    std::vector<std::uint32_t> begin, source;
+    std::vector<float> coefficient;
     std::size_t springs = 0, hinges = 0;
-    Vec3Array spring_force;  // per spring: the force on its end a (b gets minus it)
-    Vec3Array hinge_force;   // per hinge: e = k sum_i c_i x_i (particle i gets -c_i e)
+    Vec3Array element_force;
+    // The elements as the AVX-512 element pass reads them, in list order: a spring's ends, rest length, weight
+    // and which stiffness of the settings it takes (0 structural u, 1 structural v, 2 shear, 3 bending u, 4
+    // bending v); a hinge's four particles, weights c_1..c_3 (c_0 multiplies no difference) and bending
+    // weights. set_weights copies the springs' weights again after MassSpring::set_spring_weights.
+    std::vector<std::int32_t> spring_a, spring_b, spring_stiffness;
+    std::vector<float> spring_rest, spring_weight;
+    std::array<std::vector<std::int32_t>, 4> hinge_v;
+    std::array<std::vector<float>, 3> hinge_c;
+    std::vector<float> hinge_weight_u, hinge_weight_v;
+    // The same terms for the AVX-512 sum, sixteen particles a block, one lane each: block b's term t of lane l
+    // is at lanes_begin[b] + 16 t + l, for t below the lane's count (lane_terms); the rest are padding.
+    std::vector<std::uint32_t> lanes_begin, lane_source, lane_terms;
+    std::vector<float> lane_coefficient;
 
     // For `topology`'s springs and hinges (bends are the grid's: none on a mesh cloth; a topology with bends
     // gets none). Build again when the topology changes (a tear).
     static ElementGather for_topology(const Topology& topology);
+    void set_weights(const Topology& topology);
 };
 
 // Adds the springs' and hinges' forces to `force` (each particle's to what it holds, in the list path's order),

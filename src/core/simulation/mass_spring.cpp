@@ -832,7 +832,9 @@ void MassSpring::set_spring_weights(std::span<const Spring> from) {
         topology_.springs[j].weight = next[j];
     }
     if (!changed) return;
-    // The projective matrix and the stability limit hold the springs' k; the cloth wakes to feel them.
+    // The projective matrix, the stability limit and the mesh's element gather hold the springs' k; the cloth
+    // wakes to feel them.
+    if (in_->gather) in_->gather->set_weights(topology_);
     in_->invalidate_iterative();
     replan();
     wake();

@@ -113,6 +113,9 @@ public:
     // runs position Verlet), and with how many threads the current settings step.
     bool fast_solver_available() const;
     int solver_threads() const;
+    // A mesh cloth on the fast method: its springs and hinges, integration and tethers run on the work team, on
+    // this many threads (0: not on the team).
+    int mesh_team_threads() const;
     // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
     // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth) or its coloured form (coloured_xpbd.hpp:
     // the same on a mesh cloth).

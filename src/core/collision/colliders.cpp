@@ -369,11 +369,26 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
             if (!bounds.empty()) reach = glm::max(glm::abs(bounds.lo), glm::abs(bounds.hi));
         }
         if (!from_sweep || reach != glm::vec3(0.0f)) {
-            for (std::size_t k = 0; k < count; ++k) {
-                Box& box = blocks.boxes[k];
-                if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
-                box.lo -= reach;
-                box.hi += reach;
+            auto box_range = [&](std::size_t first, std::size_t last) {
+                for (std::size_t k = first; k < last; ++k) {
+                    Box& box = blocks.boxes[k];
+                    if (!from_sweep) box = particle_bounds(state.position, blocks.start[k], blocks.start[k + 1]);
+                    box.lo -= reach;
+                    box.hi += reach;
+                }
+            };
+            // On the team in pieces of 64 blocks (a mesh cloth's: the grid's are boxed in the fast solver's
+            // bands): 1024 particles, the pieces of the mesh's other stages, so each thread boxes the particles
+            // it has just moved. Each box is its block's alone: the same boxes on any number of threads.
+            constexpr std::size_t kPieceBlocks = 64;
+            const int pieces = static_cast<int>((count + kPieceBlocks - 1) / kPieceBlocks);
+            if (threads > 1 && pieces > 1) {
+                WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
+                    const std::size_t first = static_cast<std::size_t>(piece) * kPieceBlocks;
+                    box_range(first, std::min(count, first + kPieceBlocks));
+                });
+            } else {
+                box_range(0, count);
             }
         }
         blocks.cloth = union_of(blocks.boxes.data(), count);

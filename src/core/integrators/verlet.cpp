@@ -3,11 +3,16 @@
 namespace clothsim {
 
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h) {
+    integrate_verlet(state, force, gravity, damping, h, 0, state.size());
+    state.substep = h;
+}
+
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h,
+                      std::size_t first, std::size_t last) {
     const auto [keep, h2] = verlet_coefficients(damping, h);
-    const std::size_t n = state.size();
     DVec3Array& x = state.position;
     DVec3Array& motion = state.motion;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = first; i < last; ++i) {
         if (state.pinned[i]) {
             motion.set(i, glm::dvec3(0.0));
             continue;
@@ -17,7 +22,6 @@ void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, d
         motion.set(i, step);
         x.add(i, step);
     }
-    state.substep = h;
 }
 
 void start_verlet(State& state, const std::vector<glm::dvec3>& velocity, const Vec3Array& force,

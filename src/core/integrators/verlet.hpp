@@ -32,6 +32,10 @@ inline VerletCoefficients verlet_coefficients(double damping, double h) {
 // One substep of length h for every free particle; pinned particles stay where they are. The substep's
 // change (F/m + g) h2 is computed in float, the motion and the position in double.
 void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h);
+// The same for particles [first, last) alone (each particle's update is its own: any split gives the same bits),
+// leaving state.substep to the caller.
+void integrate_verlet(State& state, const Vec3Array& force, glm::vec3 gravity, double damping, double h,
+                      std::size_t first, std::size_t last);
 
 // Second-order start: x - x_prev = v h - (a - c v) h^2 / 2, with a = F/m + g at x. Sets state.substep = h.
 void start_verlet(State& state, const std::vector<glm::dvec3>& velocity, const Vec3Array& force,

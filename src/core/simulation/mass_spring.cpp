@@ -28,6 +28,10 @@ namespace clothsim {
 
 namespace {
 
+// A mesh cloth's per-particle stages on the team (integration, tethers) in pieces of this many particles: enough
+// work to pay for a claim.
+constexpr std::size_t kTeamPiece = 1024;  // as the element gather's sum: each thread finds its particles in its cache
+
 // Stamps are unique across all simulations, so a copy keeps its stamp and a new cloth never reuses one.
 std::uint64_t next_stamp() {
     static std::atomic<std::uint64_t> counter{0};
@@ -121,6 +125,7 @@ bool MassSpring::use_fast_kernel(const std::string& name) {
 int MassSpring::solver_threads() const {
     if (plan_.path != StepPath::FastVerlet) {
         const IntegratorCaches& xpbd = in_->iterative;
+        if (plan_.path == StepPath::TextbookVerlet && mesh_team_threads() > 0) return mesh_team_threads();
         if (!last_step_fast()) return 1;
         if (xpbd.grid_xpbd_ran) return xpbd.grid_xpbd->last_threads();
         return xpbd.coloured_xpbd->last_threads();
@@ -380,8 +385,7 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Springs);
         // A mesh cloth's fast path: the same sums on the team (element_gather.hpp); the textbook method is the
         // list, on one thread, the oracle.
-        if (in_->gather && settings_.solver.method == SolverMethod::Fast) {
-            const int threads = settings_.solver.threads > 0 ? settings_.solver.threads : WorkTeam::cores();
+        if (const int threads = mesh_team_threads(); threads > 0) {
             gather_spring_forces(topology_, *in_->gather, state_.position, settings_.springs, force_, threads);
         } else {
             accumulate_spring_forces(topology_, state_.position, settings_.springs, force_);
@@ -391,8 +395,24 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
     if (in_->grab) force_.add(in_->grab->particle, grab_force(state_));
     {
         StageTimer timer(profile, Stage::Integrate);
-        integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+        if (const int threads = mesh_team_threads(); threads > 0) {
+            const std::size_t n = state_.size();
+            const int pieces = static_cast<int>((n + kTeamPiece - 1) / kTeamPiece);
+            WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
+                const std::size_t first = static_cast<std::size_t>(piece) * kTeamPiece;
+                integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h, first,
+                                 std::min(n, first + kTeamPiece));
+            });
+            state_.substep = h;
+        } else {
+            integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+        }
     }
+}
+
+int MassSpring::mesh_team_threads() const {
+    if (!in_->gather || settings_.solver.method != SolverMethod::Fast) return 0;
+    return settings_.solver.threads > 0 ? settings_.solver.threads : WorkTeam::cores();
 }
 
 // On the fast path the tethers run on the fast solver's threads, each on the band of rows it has just swept, whose
@@ -401,6 +421,23 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
 // number of threads.
 std::size_t MassSpring::apply_tethers(const BlockBounds* boxes) {
     const double strain = settings_.springs.tether_strain;
+    if (const int threads = mesh_team_threads(); threads > 0 && plan_.path == StepPath::TextbookVerlet) {
+        // A mesh cloth's tethers in pieces of particles on the team (sorted by particle: a piece's are a run).
+        const std::size_t n = state_.size();
+        const int pieces = static_cast<int>((n + kTeamPiece - 1) / kTeamPiece);
+        std::vector<std::size_t>& active = in_->tether_pieces;
+        active.assign(static_cast<std::size_t>(pieces), 0);
+        WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
+            const auto first = static_cast<std::uint32_t>(static_cast<std::size_t>(piece) * kTeamPiece);
+            const auto last = static_cast<std::uint32_t>(std::min(n, static_cast<std::size_t>(first) + kTeamPiece));
+            active[static_cast<std::size_t>(piece)] = project_tethers(state_, in_->tethers, strain,
+                                                                      first_tether_from(in_->tethers, first),
+                                                                      first_tether_from(in_->tethers, last));
+        });
+        std::size_t total = 0;
+        for (std::size_t a : active) total += a;
+        return total;
+    }
     if (plan_.path != StepPath::FastVerlet || !in_->fast) return project_tethers(state_, in_->tethers, strain);
     std::array<std::size_t, 64> active{};
     const auto cols = static_cast<std::uint32_t>(topology_.cols);

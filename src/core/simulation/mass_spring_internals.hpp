@@ -30,6 +30,7 @@ struct MassSpring::Internals {
 
     std::optional<FastSolver> fast;    // when the topology is a grid
     std::optional<ElementGather> gather;  // when it is a mesh cloth: its springs and hinges on the team
+    std::vector<std::size_t> tether_pieces;  // a mesh cloth's tethers at their limit, per piece of the team's job
     IntegratorCaches iterative;        // projective's factorisation and BDF2 history, XPBD's multipliers and grid form
     CollisionBlocks blocks;            // particle blocks and their boxes for the collision broad phase
     MotionBounds motion_bounds;        // the fast solver's bounds of this substep's motion (sweep_takes_motion_bounds)

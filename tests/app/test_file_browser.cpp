@@ -11,7 +11,7 @@ using namespace clothsim;
 using clothsim::test::TempDir;
 using Catch::Matchers::Contains;
 
-TEST_CASE("file browser: folders first, then .toml files, each sorted without regard to case; hidden and other files left out") {
+TEST_CASE("file browser: folders first, then .toml files, each sorted without regard to case, hidden and other files left out") {
     const TempDir dir("browser_list");
     for (const char* f : {"b.toml", "A.toml", "notes.txt", ".hidden.toml", "c.TOML.bak"}) std::ofstream(dir / f) << "x";
     for (const char* d : {"zeta", "Alpha", ".git"}) std::filesystem::create_directories(dir / d);

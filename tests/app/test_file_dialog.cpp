@@ -83,7 +83,7 @@ TEST_CASE("file dialog: saving proposes the folder and name and asks the dialog 
           "--getsavefilename\n/home/me/a.toml\n*.toml|Scene files (*.toml)\n--title\nSave scene as\n");
 }
 
-TEST_CASE("file dialog: Cancel gives no path and no error; a dialog that fails says why") {
+TEST_CASE("file dialog: Cancel gives no path and no error, a dialog that fails says why") {
     const TempDir dir("dialog_cancel");
     DesktopDialog dialog;
     REQUIRE(dialog.start({make_tool(dir, "zenity", "exit 1").string()}) == "");
@@ -112,7 +112,7 @@ TEST_CASE("file dialog: polling never blocks while the dialog is open, and closi
     CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
 }
 
-TEST_CASE("file dialog: zenity, then kdialog, from PATH; CLOTHSIM_FILE_DIALOG chooses, imgui means the built-in browser") {
+TEST_CASE("file dialog: zenity, then kdialog, from PATH, CLOTHSIM_FILE_DIALOG chooses, imgui means the built-in browser") {
     const TempDir dir("dialog_choice");
     const Env path("PATH", dir.path().string());
     const Env display("DISPLAY", ":0");

@@ -54,7 +54,7 @@ TEST_CASE("recent files: the next run reads the list back, without files that ar
     CHECK(entries == 1);  // written atomically: only the list itself
 }
 
-TEST_CASE("recent files: relative paths are stored absolute; a list that cannot be written says why and keeps working") {
+TEST_CASE("recent files: relative paths are stored absolute, a list that cannot be written says why and keeps working") {
     const TempDir dir("recent_relative");
     const std::filesystem::path here = std::filesystem::current_path();
     std::filesystem::current_path(dir.path());

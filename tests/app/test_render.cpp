@@ -636,7 +636,7 @@ TEST_CASE("render --record: N frames, each a PNG of the window's size, numbered 
     CHECK(!fs::exists(folder / "frame-000007.png"));
 }
 
-TEST_CASE("render anti-aliasing: none by default on a software renderer, said on stdout; --samples 4 multisamples") {
+TEST_CASE("render anti-aliasing: none by default on a software renderer, said on stdout, --samples 4 multisamples") {
     // The tests' windows open on Xvfb, whose OpenGL is Mesa's llvmpipe: a software renderer, where the default
     // is no multisampling. With --samples 4 the edges are rasterised at the samples' positions, so the
     // silhouettes' pixels differ from a single-sampled picture (llvmpipe reads back sample 0: about 950 pixels

@@ -167,7 +167,7 @@ TEST_CASE("a dropped scene that does not load changes nothing the user has") {
     check_untouched(s, positions, time);
 }
 
-TEST_CASE("a dropped .obj becomes a mesh collider standing on the floor at the given point; a bad one is refused by line") {
+TEST_CASE("a dropped .obj becomes a mesh collider standing on the floor at the given point, a bad one is refused by line") {
     const clothsim::test::TempDir dir("drop_mesh");
     const std::filesystem::path crate = dir / "Crate.OBJ", bad = dir / "bad.obj";
     clothsim::write_mesh_file(clothsim::box_mesh(glm::dvec3(0.4, 0.3, 0.2)), crate, "a crate");

@@ -718,7 +718,7 @@ TEST_CASE("user session: the Colliders section adds a box, removes the ground an
     CHECK(shapes[1].enabled);
 }
 
-TEST_CASE("user session: alt + drag moves the sphere under a falling cloth, which it carries; Save keeps where it went") {
+TEST_CASE("user session: alt + drag moves the sphere under a falling cloth, which it carries, Save keeps where it went") {
     const clothsim::Scene scene = clothsim::load_scene("drape-sphere");
     const clothsim::MassSpring sim = clothsim::build_simulation(scene);
     const glm::vec3 sphere = to_screen(start_camera(sim), glm::vec3(0.0f, 0.5f, 0.0f));
@@ -741,7 +741,7 @@ TEST_CASE("user session: alt + drag moves the sphere under a falling cloth, whic
     CHECK(saved.settings.colliders.shapes[0].motion == clothsim::ColliderMotion{});  // at rest where it went
 }
 
-TEST_CASE("user session: an .obj dropped onto the window stands on the floor under the cursor; a bad one is refused") {
+TEST_CASE("user session: an .obj dropped onto the window stands on the floor under the cursor, a bad one is refused") {
     const TempDir dir("session_drop_mesh");
     const fs::path crate = dir / "crate.obj", bad = dir / "bad.obj";
     clothsim::write_mesh_file(clothsim::box_mesh(glm::dvec3(0.4, 0.3, 0.2)), crate, "a crate");

@@ -300,7 +300,7 @@ TEST_CASE("apply_fabric: refuses another grid or another form, changing nothing"
     CHECK(sim.settings() == copy.settings());
 }
 
-TEST_CASE("set_masses: keeps velocities, so the kinetic energy scales with the mass; refuses bad masses", "[fabric]") {
+TEST_CASE("set_masses: keeps velocities, so the kinetic energy scales with the mass, refuses bad masses", "[fabric]") {
     MassSpring sim = build_simulation(load_scene("falling"));
     sim.run_steps(10);
     const double kinetic = sim.energy().kinetic;

@@ -318,7 +318,7 @@ TEST_CASE("cloth mesh: a mesh too small for its vertices to carry a mass is refu
                                                Catch::Contains("too little for a mass"));
 }
 
-TEST_CASE("cloth mesh: masses are density x a third of each triangle; the cloth weighs density x area", "[cloth_mesh]") {
+TEST_CASE("cloth mesh: masses are density x a third of each triangle, the cloth weighs density x area", "[cloth_mesh]") {
     const Mesh m = rectangle_mesh(9, 0.4, 0.1, 0.2, 5);
     Scene s = mesh_scene(m, glm::vec2(1000.0f), 1e-5f);
     const MassSpring sim = build_simulation(s);
@@ -524,7 +524,7 @@ TEST_CASE("cloth mesh: the hanging cloth given as an OBJ of its own grid hangs l
     }
 }
 
-TEST_CASE("cloth mesh: every integrator steps a mesh cloth; without damping the explicit ones keep its energy, "
+TEST_CASE("cloth mesh: every integrator steps a mesh cloth, without damping the explicit ones keep its energy, "
           "the implicit ones lose it",
           "[cloth_mesh][integrators]") {
     const Mesh m = delaunay_rectangle(0.05, 0.6, 0.4, 0.2, 9);

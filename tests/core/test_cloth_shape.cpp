@@ -71,7 +71,7 @@ TEST_CASE("cloth shape: a disc keeps the particles inside the inscribed circle a
     }
 }
 
-TEST_CASE("cloth shape: absent particles have no mass, springs, bends or triangles; the disc weighs density x area",
+TEST_CASE("cloth shape: absent particles have no mass, springs, bends or triangles, the disc weighs density x area",
           "[cloth_shape]") {
     for (bool material : {true, false}) {
         const Scene s = disc_scene(24, material);

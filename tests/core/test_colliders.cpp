@@ -713,7 +713,7 @@ TEST_CASE("colliders a mesh that jumps onto the cloth (a typed position, a dropp
     }
 }
 
-TEST_CASE("colliders a cloth built inside a closed mesh starts outside it; an open mesh moves nothing", "[colliders]") {
+TEST_CASE("colliders a cloth built inside a closed mesh starts outside it, an open mesh moves nothing", "[colliders]") {
     Scene scene = level_square(10, 0.4f, 0.5f);
     scene.pins = PinSpec{PinPreset::None, {}, 0.0f, ClipKind::Rigid};
     MeshCollider box;

@@ -66,6 +66,9 @@ TEST_CASE("element gather: a live change of an anisotropic fabric reaches the ga
     scene.pins = PinSpec{PinPreset::None, {}, 0.0f, ClipKind::Rigid};
     apply_override(scene, "cloth.mesh=\"cusick-disc-2k.obj\"");
     apply_override(scene, "material.stretch=[3000, 1000]");
+    // Steps of a tenth of the scene's, at its substep length: a short run, as the check needs.
+    apply_override(scene, "integration.dt=" + std::to_string(scene.settings.integration.dt / 10.0));
+    apply_override(scene, "integration.substeps=" + std::to_string((scene.settings.integration.substeps + 9) / 10));
     Scene textbook = scene;
     apply_override(scene, "solver.method=\"fast\"");
     apply_override(textbook, "solver.method=\"textbook\"");

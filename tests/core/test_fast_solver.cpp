@@ -167,7 +167,7 @@ TEST_CASE("fast solver keeps pins fixed and every particle outside the colliders
     }
 }
 
-TEST_CASE("fast solver is only used for grid topologies; others run the textbook path", "[fast_solver]") {
+TEST_CASE("fast solver is only used for grid topologies, others run the textbook path", "[fast_solver]") {
     Topology t;
     t.rows = 1;
     t.cols = 3;

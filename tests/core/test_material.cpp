@@ -322,7 +322,7 @@ TEST_CASE("material: spring constants reproduce the stretch, shear and bending t
     CHECK_THROWS_WITH(spring_constants(s.cloth, s.material), Catch::Contains("at least 2 x 2"));
 }
 
-TEST_CASE("material: each particle carries a quarter of each cell around it; the cloth weighs density x area",
+TEST_CASE("material: each particle carries a quarter of each cell around it, the cloth weighs density x area",
           "[material]") {
     Scene s = parse_scene("[cloth]\nrows = 5\ncols = 9\nsize = [0.8, 0.4]\n[material]\ndensity = 0.2\n", "t.toml");
     const MassSpring sim = build_simulation(s);
@@ -378,7 +378,7 @@ TEST_CASE("material: a preset fills the fields a scene does not set, in any orde
 }
 
 TEST_CASE("material: an old preset name loads the fabric it stood for, saved under that fabric's name, with a note "
-          "that says so; a preset's own name gives no note", "[material]") {
+          "that says so, and a preset's own name gives no note", "[material]") {
     const struct {
         const char* old_name;
         const char* name;

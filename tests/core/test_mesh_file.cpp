@@ -92,7 +92,7 @@ TEST_CASE("mesh file a claim of more triangles than allowed is refused before th
     CHECK_THROWS_WITH(read_mesh_file(huge), Contains("huge.obj: the file has 268435457 bytes; allowed: at most 268435456 (256 MB)"));
 }
 
-TEST_CASE("mesh file a scene's mesh is found beside it, then among the bundled meshes; a bad one keeps the scene",
+TEST_CASE("mesh file a scene's mesh is found beside it, then among the bundled meshes, a bad one keeps the scene",
           "[mesh_file]") {
     TempDir dir("mesh");
     write(dir, "square.obj", kSquare);

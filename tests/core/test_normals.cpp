@@ -14,7 +14,7 @@
 
 using namespace clothsim;
 
-TEST_CASE("normals: a flat cloth's are u x v; a folded one's average by area", "[normals]") {
+TEST_CASE("normals: a flat cloth's are u x v, a folded one's average by area", "[normals]") {
     Scene s;
     s.cloth.rows = 4;
     s.cloth.cols = 5;

@@ -106,7 +106,7 @@ std::vector<double> halving_changes(const Scene& s, double duration, double h0, 
 
 }  // namespace
 
-TEST_CASE("reference with penalty contact converges on the drape; with projection contact it does not",
+TEST_CASE("reference with penalty contact converges on the drape, with projection contact it does not",
           "[reference]") {
     // docs/ACCURACY.md, "Contact in the accuracy study". 0.25 s: the cloth falls 0.15 m onto the sphere
     // (at 0.17 s) and its corners swing down around it.

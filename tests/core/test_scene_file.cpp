@@ -1036,7 +1036,7 @@ TEST_CASE("scene copy_field: every field of every kind takes the other scene's v
     CHECK(kinds_copied.size() >= 7);  // int, float, bool, vec2, vec3, string, pins and enumerations among them
 }
 
-TEST_CASE("scene file: a collider's velocity and spin load, override, round-trip; a spin its shape cannot follow is refused") {
+TEST_CASE("scene file: a collider's velocity and spin load, override, round-trip, a spin its shape cannot follow is refused") {
     using namespace clothsim;
     const Scene s = parse_scene("[[colliders.shapes]]\nkind = \"sphere\"\ncenter = [0, 0.3, -1]\nradius = 0.3\n"
                                 "velocity = [0, 0, 0.5]\nspin = [-95.5, 0, 0]\n",

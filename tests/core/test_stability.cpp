@@ -163,7 +163,7 @@ TEST_CASE("stability plane-wave bound on a grid is 4 (k_struct + k_shear + k_ben
     CHECK(undamped.plane_wave_substep == Approx(2.0 / undamped.omega_plane_wave).epsilon(1e-9));
 }
 
-TEST_CASE("stability rk4 reaches sqrt(2) times verlet's substep; implicit euler and xpbd have no limit",
+TEST_CASE("stability rk4 reaches sqrt(2) times verlet's substep, implicit euler and xpbd have no limit",
           "[stability]") {
     Scene s = free_grid(8, 1000.0f);
     const MassSpring verlet = build_simulation(s);

@@ -158,7 +158,7 @@ TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {
     CHECK(said);
 }
 
-TEST_CASE("cutting: a stroke across a hanging sheet parts it there; the lower piece falls, the upper still hangs", "[tearing]") {
+TEST_CASE("cutting: a stroke across a hanging sheet parts it there, the lower piece falls, the upper still hangs", "[tearing]") {
     Scene s = load_scene("hanging");
     test::collider(s.settings.colliders, "ground").enabled = false;
     s.settings.springs.tether_strain = 0.0f;

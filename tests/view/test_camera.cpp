@@ -92,7 +92,7 @@ TEST_CASE("camera right, up and forward are orthonormal and right-handed") {
     }
 }
 
-TEST_CASE("camera yaw 0 and pitch 0 look along -z; yaw turns about +y") {
+TEST_CASE("camera yaw 0 and pitch 0 look along -z, yaw turns about +y") {
     OrbitCamera c;
     c.target = glm::vec3(1.0f, 2.0f, 3.0f);
     c.distance = 4.0f;

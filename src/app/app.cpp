@@ -279,7 +279,7 @@ std::optional<ObjectDrag> pick_object(const AppState& app, const Ray& ray) {
         const auto t = segment_entry(list[i], from, to);
         if (!t || *t >= nearest) continue;
         nearest = *t;
-        best = ObjectDrag{i, glm::vec3(from + *t * (to - from)), -app.camera.forward(), glm::vec3(pivot(list[i]))};
+        best = ObjectDrag{i, glm::vec3(from + *t * (to - from)), -app.camera.forward(), glm::vec3(pivot(list[i])), {}};
     }
     return best;
 }
@@ -288,20 +288,23 @@ std::optional<ObjectDrag> pick_object(const AppState& app, const Ray& ray) {
 // over the time this frame will simulate (MassSpring::move_collider), so the cloth it touches is pushed and
 // carried with that velocity; released, it stays where it got to. While paused it is put there at once.
 void drag_object(AppState& app, const Window& window, float scale) {
-    const ObjectDrag& drag = *app.object_drag;
+    ObjectDrag& drag = *app.object_drag;
     const auto p = intersect_plane(cursor_ray(app, window, scale), drag.plane_point, drag.plane_normal);
     if (!p) return;
     const double dt = app.sim.settings().integration.dt;
     const double seconds = app.paused ? 0.0 : std::max(dt, 1e-3 * app.stats.frame_ms * app.time_scale);
-    app.sim.move_collider(drag.collider, drag.start + (*p - drag.plane_point), seconds);
+    drag.target = drag.start + (*p - drag.plane_point);
+    app.sim.move_collider(drag.collider, *drag.target, seconds);
 }
 
+// Let go: the collider is put where the cursor last put it, at rest.
 void release_object(AppState& app) {
     const std::size_t i = app.object_drag->collider;
+    const std::optional<glm::vec3> target = app.object_drag->target;
     app.object_drag.reset();
     const std::vector<Collider>& list = app.sim.colliders();
     if (i >= list.size()) return;
-    const glm::vec3 at(pivot(list[i]));
+    const glm::vec3 at = target ? *target : glm::vec3(pivot(list[i]));
     app.sim.move_collider(i, at, 0.0);
     char line[160];
     std::snprintf(line, sizeof line, "collider %zu (%s) moved to (%.3g, %.3g, %.3g)", i,

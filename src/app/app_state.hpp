@@ -124,6 +124,9 @@ struct ObjectDrag {
     glm::vec3 plane_point{0.0f};
     glm::vec3 plane_normal{0.0f, 0.0f, 1.0f};
     glm::vec3 start{0.0f};  // the collider's centre (a mesh: its position) when picked
+    // Where the cursor puts it: the collider moves there over the frame's time, and is put there when let go
+    // (a simulation behind the wall clock, as at a low frame rate, has not yet carried it all the way).
+    std::optional<glm::vec3> target;
 };
 
 // A recording in progress: every drawn frame written as DIR/frame-NNNNNN.png (one step of integration.dt

@@ -9,10 +9,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: clothsim-make-meshes DIR\n");
+    constexpr const char* kUsage = "usage: clothsim-make-meshes DIR\n  writes the bundled meshes (OBJ) into DIR, made if missing\n";
+    // A flag is never taken for a folder to write into (a folder named "-x" is written as ./-x).
+    if (argc == 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
+        std::fputs(kUsage, stdout);
+        return 0;
+    }
+    if (argc != 2 || argv[1][0] == '-') {
+        if (argc >= 2 && argv[1][0] == '-') std::fprintf(stderr, "clothsim-make-meshes: unknown option %s\n", argv[1]);
+        std::fputs(kUsage, stderr);
         return 2;
     }
     const std::filesystem::path dir(argv[1]);

@@ -1,4 +1,4 @@
-// make_textures: writes the two procedural textures the renderer uses, as 256x256 RGB PNGs, and the
+// clothsim-make-textures: writes the two procedural textures the renderer uses, as 256x256 RGB PNGs, and the
 // program's icon.
 //   fabric.png  a tileable red-orange 2/2 twill weave, with lighter thread stripes every 32 px so that the
 //               motion of the cloth stays visible.
@@ -6,7 +6,7 @@
 //               cube collider.
 //   clothsim.png the desktop icon (256x256 RGBA, installed under share/icons): an orange cloth with its grid
 //               of springs, hanging from two pins, on a rounded dark-blue tile.
-// Usage: make_textures OUTPUT_DIR [ICON_DIR]. Output is deterministic (fixed-seed integer hashing, no clock or RNG), so
+// Usage: clothsim-make-textures OUTPUT_DIR [ICON_DIR]. Output is deterministic (fixed-seed integer hashing, no clock or RNG), so
 // regenerating never shows up as a change in git. Exit codes: 0 ok, 2 bad usage or a failed write.
 #include <stb_image_write.h>
 
@@ -18,6 +18,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -201,7 +202,7 @@ Image make_crate() {
 bool write_png(const std::filesystem::path& path, const Image& img) {
     const std::string name = path.string();
     if (stbi_write_png(name.c_str(), kSize, kSize, kChannels, img.data(), kSize * kChannels) == 0) {
-        std::cerr << "make_textures: failed to write " << name << '\n';
+        std::cerr << "clothsim-make-textures: failed to write " << name << '\n';
         return false;
     }
     std::cout << "wrote " << name << " (" << kSize << "x" << kSize << " RGB)\n";
@@ -265,9 +266,21 @@ std::vector<unsigned char> make_icon() {
 }  // namespace
 
 int main(int argc, char** argv) {
+    constexpr const char* kUsage = "usage: clothsim-make-textures OUTPUT_DIR [ICON_DIR]\n"
+                                   "  writes OUTPUT_DIR/fabric.png and OUTPUT_DIR/crate.png, and ICON_DIR/clothsim.png\n";
+    // A flag is never taken for a folder to write into (a folder named "-x" is written as ./-x).
+    if (argc == 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
+        std::cout << kUsage;
+        return 0;
+    }
+    for (int i = 1; i < argc; ++i) {
+        if (argv[i][0] == '-') {
+            std::cerr << "clothsim-make-textures: unknown option " << argv[i] << '\n' << kUsage;
+            return 2;
+        }
+    }
     if (argc != 2 && argc != 3) {
-        std::cerr << "usage: make_textures OUTPUT_DIR [ICON_DIR]\n"
-                     "  writes OUTPUT_DIR/fabric.png and OUTPUT_DIR/crate.png, and ICON_DIR/clothsim.png\n";
+        std::cerr << kUsage;
         return 2;
     }
     const std::filesystem::path dir = argv[1];
@@ -275,7 +288,7 @@ int main(int argc, char** argv) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) {
-        std::cerr << "make_textures: cannot create directory " << dir.string() << ": " << ec.message() << '\n';
+        std::cerr << "clothsim-make-textures: cannot create directory " << dir.string() << ": " << ec.message() << '\n';
         return 2;
     }
     if (!write_png(dir / "fabric.png", make_fabric()) || !write_png(dir / "crate.png", make_crate())) {
@@ -287,7 +300,7 @@ int main(int argc, char** argv) {
         const std::string icon = (icon_dir / "clothsim.png").string();
         const std::vector<unsigned char> pixels = make_icon();
         if (ec || stbi_write_png(icon.c_str(), kSize, kSize, 4, pixels.data(), kSize * 4) == 0) {
-            std::cerr << "make_textures: failed to write " << icon << '\n';
+            std::cerr << "clothsim-make-textures: failed to write " << icon << '\n';
             return 2;
         }
         std::cout << "wrote " << icon << " (" << kSize << "x" << kSize << " RGBA)\n";

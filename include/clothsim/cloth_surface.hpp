@@ -13,6 +13,10 @@
 // shows a clean seam where the two sides meet, a tear that opens shows a crack as wide as the pieces have
 // parted beyond their rest, and no triangle spans a broken spring. The particles keep their indices (first);
 // the split vertices follow them. Edge points on an edge of two torn cells are shared by both.
+// A mesh cloth (cloth.mesh) splits the same way with its triangles as the cells: a torn triangle, one it had
+// when built that lost an edge's spring, is drawn as three corner quadrilaterals (the corner, its two edges'
+// points and the piece's centre, the mean over the piece's corners of (2 e_1 + 2 e_2 - p) / 3: the triangle's
+// centroid while its edges hold, so the six triangles tile it); a broken edge's end points at the other end.
 #pragma once
 
 #include "clothsim/state.hpp"
@@ -35,7 +39,8 @@ struct ClothSurface {
         float half_rest = 0.0f;
         bool whole = false;
     };
-    // The centre of one piece of a torn cell: the mean over its corners of e_1 + e_2 - p (vertex indices).
+    // The centre of one piece of a torn cell: the mean over its corners of e_1 + e_2 - p on a grid, of
+    // (2 e_1 + 2 e_2 - p) / 3 on a mesh cloth's triangle (vertex indices).
     struct Centre {
         std::array<std::array<std::uint32_t, 3>, 4> corner{};  // {p, e_1, e_2}
         int count = 0;
@@ -48,25 +53,32 @@ struct ClothSurface {
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<EdgePoint> edge_points;  // vertices particles .. particles + edge_points.size() - 1
     std::vector<Centre> centres;         // then these
-    std::vector<glm::vec2> split_grid;   // each split vertex's place on the grid: (column, row), for its UV
+    // Each split vertex's place, for its UV: (column, row) on a grid (grid_uv); its texture coordinate (m, as
+    // Topology::uv) on a mesh cloth.
+    std::vector<glm::vec2> split_place;
+    bool mesh = false;  // the cells are a mesh cloth's triangles
 
     bool split() const { return !triangles.empty(); }
     std::size_t vertex_count() const { return particles + edge_points.size() + centres.size(); }
 };
 
-// Per grid cell (row-major, (rows - 1) x (cols - 1)), 1 where the topology has both the builder's triangles of
-// the cell, (00, 01, 10) and (01, 11, 10); empty when it is not a grid of `particles`. Taken when the cloth is
-// built, it says which cells a tear can leave torn.
-std::vector<std::uint8_t> whole_cells(const Topology& topology, std::size_t particles);
+// The cells a tear can leave torn, taken when the cloth is built.
+struct ClothCells {
+    // A grid: per cell (row-major, (rows - 1) x (cols - 1)), 1 where the topology has both the builder's
+    // triangles of the cell, (00, 01, 10) and (01, 11, 10). Empty otherwise.
+    std::vector<std::uint8_t> whole;
+    // A mesh cloth: its triangles as built. Empty otherwise.
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+ClothCells cells_at_start(const Topology& topology, std::size_t particles);
 
-// The surface of `topology`: the cells whole at the start (whole_cells) that have lost a triangle are split.
-// Any other topology, or one with no torn cell, gives an unsplit surface. `rest` holds the rest positions the
-// rest lengths come from.
-ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest,
-                                 const std::vector<std::uint8_t>& whole_at_start);
+// The surface of `topology`: the cells of `at_start` (cells_at_start) that have lost a triangle are split. Any
+// other topology, or one with no torn cell, gives an unsplit surface. `rest` holds the rest positions the rest
+// lengths come from.
+ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest, const ClothCells& at_start);
 
 // The texture coordinate of a place on the grid, (column, row): u from 0 at column 0 to 1 at the last, v from 1
-// at row 0 to 0 at the last. Particles and split vertices (ClothSurface::split_grid) alike.
+// at row 0 to 0 at the last. Particles and a grid's split vertices (ClothSurface::split_place) alike.
 glm::vec2 grid_uv(const Topology& topology, glm::vec2 grid);
 
 // Resizes `vertices`, which holds the particles' positions, to surface.vertex_count() and writes the split

@@ -305,7 +305,7 @@ private:
     std::size_t broken_springs_ = 0;
     std::uint64_t topology_stamp_ = 0;
     ClothSurface surface_;       // follows topology_ (topology_changed)
-    std::vector<std::uint8_t> whole_cells_;  // the grid cells with both their triangles as built (cloth_surface.hpp)
+    ClothCells cells_at_start_;  // the cells a tear can leave torn, as built (cloth_surface.hpp)
     StepPlan plan_;
     StepProfile profile_;
     bool profiling_ = true;

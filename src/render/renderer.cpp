@@ -179,7 +179,7 @@ void Renderer::sync_cloth(const MassSpring& sim, bool rebuild) {
                 for (int c = 0; c < t.cols; ++c) data.uvs.push_back(grid_uv(t, glm::vec2(float(c), float(r))));
             }
         }
-        for (const glm::vec2& grid : surface.split_grid) data.uvs.push_back(grid_uv(t, grid));
+        for (const glm::vec2& place : surface.split_place) data.uvs.push_back(t.mesh ? place : grid_uv(t, place));
         for (const auto& tri : surface.split() ? surface.triangles : t.triangles) {
             data.indices.insert(data.indices.end(), tri.begin(), tri.end());
         }

@@ -2,6 +2,7 @@
 // and an opened tear as a crack, never as a missing row of cells, and no triangle spans a broken spring.
 #include "support.hpp"
 
+#include "clothsim/cloth_mesh_shapes.hpp"
 #include "clothsim/cloth_surface.hpp"
 #include "clothsim/export.hpp"
 #include "clothsim/scene.hpp"
@@ -15,6 +16,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <sstream>
 #include <string>
 
 using namespace clothsim;
@@ -88,6 +91,33 @@ double piece_area(const MassSpring& sim, const std::vector<glm::vec3>& v, std::u
 // Cuts every spring that crosses the plane z = 0.35 (between rows 3 and 4).
 std::size_t cut_between_rows_3_and_4(MassSpring& sim) {
     return sim.cut([](glm::vec3 a, glm::vec3 b) { return (a.z - 0.35f) * (b.z - 0.35f) < 0.0f; });
+}
+
+// A flat, free, weightless mesh cloth (cloth.mesh): the boundary-conforming disc of radius 0.35 m in 7 rings of
+// 5 cm (cloth_mesh_shapes.hpp) in the plane y = 1, wound as the grid (normal -y).
+MassSpring flat_disc_mesh(glm::vec3 gravity = glm::vec3(0.0f)) {
+    Scene s;
+    s.cloth.mesh = "disc.obj";
+    s.cloth.mesh_data = std::make_shared<TriangleMesh>(cloth_disc(0.35, 7));
+    s.cloth.origin = {0.0f, 1.0f, 0.0f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 0.0f, 1.0f};
+    s.pins.preset = PinPreset::None;
+    s.settings.forces.gravity = gravity;
+    test::collider(s.settings.colliders, "ground").enabled = false;
+    return build_simulation(s);
+}
+
+double triangles_area(const MassSpring& sim) {
+    const std::vector<glm::vec3> v = sim.positions();
+    double sum = 0.0;
+    for (const auto& t : sim.topology().triangles) sum += area(v, t);
+    return sum;
+}
+
+// Cuts every spring that crosses the plane z = 0.1213 (between vertices of the disc, off every one).
+std::size_t cut_disc_chord(MassSpring& sim) {
+    return sim.cut([](glm::vec3 a, glm::vec3 b) { return (a.z - 0.1213f) * (b.z - 0.1213f) < 0.0f; });
 }
 
 }  // namespace
@@ -282,4 +312,127 @@ TEST_CASE("cloth surface: a tear pulled open keeps every triangle within one pie
     split_surface_normals(sim.surface(), v, normals);
     REQUIRE(normals.size() == v.size());
     for (const glm::vec3& n : normals) CHECK(glm::length(n) == Approx(1.0f).epsilon(1e-5));
+}
+
+TEST_CASE("cloth surface: a mesh cloth cut along a chord is a closed seam, as the grid: the area stays, the ends "
+          "of each broken edge meet, no triangle spans the cut", "[tearing]") {
+    MassSpring sim = flat_disc_mesh();
+    REQUIRE(sim.topology().mesh);
+    const double whole = triangles_area(sim);
+    // The side the mesh's triangles face (every one the same way on the flat disc).
+    const std::vector<glm::vec3> rest = sim.positions();
+    const auto& first = sim.topology().triangles.front();
+    const float facing = glm::cross(rest[first[1]] - rest[first[0]], rest[first[2]] - rest[first[0]]).y > 0.0f ? 1.0f : -1.0f;
+    const std::size_t springs = sim.topology().springs.size();
+    REQUIRE(cut_disc_chord(sim) > 0);
+    const std::size_t broken = springs - sim.topology().springs.size();
+    REQUIRE(broken > 0);
+    const ClothSurface& s = sim.surface();
+    REQUIRE(s.split());
+    CHECK(s.mesh);
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    REQUIRE(v.size() == s.vertex_count());
+    double total = 0.0;
+    for (const auto& t : s.triangles) {
+        total += area(v, t);
+        const glm::vec3 n = glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
+        CHECK(facing * n.y > 0.0f);  // wound as the mesh's own triangles
+    }
+    // Dropping the triangles that lost an edge would leave a strip along the chord out; each torn triangle is
+    // drawn as six triangles about its centroid, which tile it.
+    CHECK(total == Approx(whole).epsilon(1e-5));
+    CHECK(triangles_area(sim) < 0.95 * whole);
+    // Each broken edge has a point at each end, and on the flat cloth they coincide at its middle.
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
+        for (std::size_t j = i + 1; j < s.edge_points.size(); ++j) {
+            const auto &a = s.edge_points[i], &b = s.edge_points[j];
+            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
+            ++pairs;
+            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) < 1e-6f);
+            CHECK(glm::length(v[s.particles + i] - 0.5f * (v[a.from] + v[a.to])) < 1e-6f);
+        }
+    }
+    CHECK(pairs == broken);
+    // Vertices that coincide belong to different pieces: nothing is split within one.
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        for (std::size_t j = i + 1; j < v.size(); ++j) {
+            if (glm::length(v[i] - v[j]) > 1e-6f) continue;
+            INFO("vertices " << i << " and " << j << " coincide");
+            CHECK(piece[i] != piece[j]);
+        }
+    }
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: a mesh vertex cut free keeps its own patch, a third of each triangle around it", "[tearing]") {
+    MassSpring sim = flat_disc_mesh();
+    const std::uint32_t lone = 20;  // on ring 3 (vertices 19 .. 36)
+    const std::vector<glm::vec3> before = sim.positions();
+    double patch = 0.0;
+    for (const auto& t : sim.topology().triangles) {
+        if (t[0] == lone || t[1] == lone || t[2] == lone) patch += area(before, t) / 3.0;
+    }
+    const double whole = triangles_area(sim);
+    const glm::vec3 p = sim.position(lone);
+    REQUIRE(sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a == p) != (b == p); }) > 0);
+    for (const Spring& sp : sim.topology().springs) CHECK((sp.a != lone && sp.b != lone));
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    REQUIRE(piece[lone] != piece[0]);
+    CHECK(piece_area(sim, v, piece[lone]) == Approx(patch).epsilon(1e-5));
+    CHECK(piece_area(sim, v, piece[0]) == Approx(whole - patch).epsilon(1e-5));
+    check_surface_respects_the_tears(sim);
+}
+
+TEST_CASE("cloth surface: a torn mesh cloth falling apart keeps every triangle within one piece, and its OBJ has "
+          "a texture coordinate per vertex", "[tearing]") {
+    MassSpring sim = flat_disc_mesh(glm::vec3(0.0f, -9.81f, 0.0f));
+    sim.set_pinned(0, true);  // the centre
+    REQUIRE(cut_disc_chord(sim) > 0);
+    sim.run_steps(20);  // the cap beyond the chord falls about 0.5 m
+    const ClothSurface& s = sim.surface();
+    REQUIRE(s.split());
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    for (const glm::vec3& p : v) REQUIRE(std::isfinite(p.x + p.y + p.z));
+    check_surface_respects_the_tears(sim);
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    float gap = INFINITY;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        for (std::size_t j = 0; j < v.size(); ++j) {
+            if (piece[i] != piece[j]) gap = std::min(gap, glm::length(v[i] - v[j]));
+        }
+    }
+    CHECK(gap > 0.05f);  // the drawn pieces parted with the cloth's
+    std::vector<glm::vec3> normals;
+    split_surface_normals(s, v, normals);
+    for (const glm::vec3& n : normals) CHECK(glm::length(n) == Approx(1.0f).epsilon(1e-5));
+    // The OBJ: the split surface with a texture coordinate for every vertex, faces naming both.
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("clothsim-torn-mesh-" + std::to_string(::getpid()) + ".obj")).string();
+    std::string error;
+    REQUIRE(write_obj(sim, path, error));
+    std::ifstream in(path);
+    std::size_t faces = 0, vertices = 0, uvs = 0;
+    bool indices_in_range = true;
+    for (std::string line; std::getline(in, line);) {
+        vertices += line.rfind("v ", 0) == 0 ? 1 : 0;
+        uvs += line.rfind("vt ", 0) == 0 ? 1 : 0;
+        if (line.rfind("f ", 0) != 0) continue;
+        ++faces;
+        std::istringstream f(line.substr(2));
+        for (std::string corner; f >> corner;) {
+            const std::size_t slash = corner.find('/');
+            REQUIRE(slash != std::string::npos);
+            const std::size_t index = std::stoul(corner.substr(0, slash)), texture = std::stoul(corner.substr(slash + 1));
+            indices_in_range = indices_in_range && index >= 1 && index <= s.vertex_count() && texture == index;
+        }
+    }
+    in.close();
+    std::filesystem::remove(path);
+    CHECK(faces == s.triangles.size());
+    CHECK(vertices == s.vertex_count());
+    CHECK(uvs == s.vertex_count());
+    CHECK(indices_in_range);
 }

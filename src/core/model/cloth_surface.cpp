@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace clothsim {
 namespace {
@@ -50,14 +51,107 @@ std::vector<std::uint8_t> drawn_cells(const Topology& topology, std::size_t part
 
 }  // namespace
 
-std::vector<std::uint8_t> whole_cells(const Topology& topology, std::size_t particles) {
-    std::vector<std::uint8_t> whole = drawn_cells(topology, particles);
-    for (std::uint8_t& cell : whole) cell = cell == 3 ? 1 : 0;
-    return whole;
+ClothCells cells_at_start(const Topology& topology, std::size_t particles) {
+    ClothCells cells;
+    if (topology.mesh) {
+        cells.triangles = topology.triangles;
+        return cells;
+    }
+    cells.whole = drawn_cells(topology, particles);
+    for (std::uint8_t& cell : cells.whole) cell = cell == 3 ? 1 : 0;
+    return cells;
 }
 
-ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest,
-                                 const std::vector<std::uint8_t>& whole_at_start) {
+namespace {
+
+// A mesh cloth's surface: its torn triangles (in `built`, not in the topology's: tearing only removes) drawn as
+// three corner quadrilaterals each.
+ClothSurface build_mesh_surface(const Topology& topology, const DVec3Array& rest,
+                                const std::vector<std::array<std::uint32_t, 3>>& built) {
+    ClothSurface surface;
+    surface.particles = rest.size();
+    surface.mesh = true;
+    const auto& present = topology.triangles;
+    std::vector<std::array<std::uint32_t, 3>> torn;
+    std::size_t next = 0;
+    for (const auto& t : built) {
+        if (next < present.size() && present[next] == t) ++next;
+        else torn.push_back(t);
+    }
+    // Not a subsequence of the triangles as built (none are ever added): draw the topology as it is.
+    if (torn.empty() || next != present.size() || topology.uv.size() != rest.size()) return surface;
+
+    std::unordered_set<std::uint64_t> held;
+    for (const Spring& sp : topology.springs) {
+        if (sp.kind != SpringKind::Bending) held.insert(pair_key(sp.a, sp.b));
+    }
+    auto holds = [&](std::uint32_t a, std::uint32_t b) { return held.count(pair_key(a, b)) != 0; };
+    surface.triangles = present;
+    std::unordered_map<std::uint64_t, std::uint32_t> edge_vertex;
+    auto edge_point = [&](std::uint32_t from, std::uint32_t to) {
+        const bool whole = holds(from, to);
+        const std::uint64_t key = whole ? pair_key(from, to) : ((static_cast<std::uint64_t>(from) << 32) | to);
+        const auto found = edge_vertex.find(key);
+        if (found != edge_vertex.end()) return found->second;
+        ClothSurface::EdgePoint e;
+        e.from = from;
+        e.to = to;
+        e.whole = whole;
+        e.back = ClothSurface::kNoParticle;  // a mesh has no row to continue: a broken edge's end points at the other
+        e.half_rest = static_cast<float>(0.5 * glm::length(rest.get(to) - rest.get(from)));
+        const auto index = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
+        surface.edge_points.push_back(e);
+        surface.split_place.push_back(0.5f * (topology.uv[from] + topology.uv[to]));
+        edge_vertex.emplace(key, index);
+        return index;
+    };
+    // Every edge point first, then the centres, so that the centres' indices follow all edge points.
+    for (const auto& k : torn) {
+        for (int i = 0; i < 3; ++i) {
+            edge_point(k[i], k[(i + 1) % 3]);
+            edge_point(k[i], k[(i + 2) % 3]);
+        }
+    }
+    const auto first_centre = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
+    for (const auto& k : torn) {
+        // The triangle's pieces: corners joined by a held edge.
+        std::array<int, 3> piece = {0, 1, 2};
+        auto find = [&](int i) {
+            while (piece[i] != i) i = piece[i];
+            return i;
+        };
+        for (int i = 0; i < 3; ++i) {
+            for (int j = i + 1; j < 3; ++j) {
+                if (holds(k[i], k[j])) piece[std::max(find(i), find(j))] = std::min(find(i), find(j));
+            }
+        }
+        const glm::vec2 centroid = (topology.uv[k[0]] + topology.uv[k[1]] + topology.uv[k[2]]) / 3.0f;
+        std::array<std::uint32_t, 3> centre_of{};
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t after = edge_point(k[i], k[(i + 1) % 3]), before = edge_point(k[i], k[(i + 2) % 3]);
+            const int root = find(i);
+            if (root == i) {
+                centre_of[i] = static_cast<std::uint32_t>(surface.centres.size());
+                surface.centres.emplace_back();
+                surface.split_place.push_back(centroid);
+            } else {
+                centre_of[i] = centre_of[root];
+            }
+            ClothSurface::Centre& centre = surface.centres[centre_of[i]];
+            centre.corner[static_cast<std::size_t>(centre.count++)] = {k[i], after, before};
+            const std::uint32_t middle = first_centre + centre_of[i];
+            surface.triangles.push_back({k[i], after, middle});
+            surface.triangles.push_back({k[i], middle, before});
+        }
+    }
+    return surface;
+}
+
+}  // namespace
+
+ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& rest, const ClothCells& at_start) {
+    if (topology.mesh) return build_mesh_surface(topology, rest, at_start.triangles);
+    const std::vector<std::uint8_t>& whole_at_start = at_start.whole;
     ClothSurface surface;
     const int rows = topology.rows, cols = topology.cols;
     const std::size_t n = rest.size();
@@ -128,7 +222,7 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
         }
         const auto index = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
         surface.edge_points.push_back(e);
-        surface.split_grid.push_back(0.5f * (place(from) + place(to)));
+        surface.split_place.push_back(0.5f * (place(from) + place(to)));
         edge_vertex.emplace(key, index);
         return index;
     };
@@ -170,7 +264,7 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
             if (root == i) {
                 centre_of[i] = static_cast<std::uint32_t>(surface.centres.size());
                 surface.centres.emplace_back();
-                surface.split_grid.push_back(glm::vec2(float(c) + 0.5f, float(r) + 0.5f));
+                surface.split_place.push_back(glm::vec2(float(c) + 0.5f, float(r) + 0.5f));
             } else {
                 centre_of[i] = centre_of[root];
             }
@@ -219,7 +313,8 @@ void place_split_vertices(const ClothSurface& surface, std::vector<glm::vec3>& v
         glm::vec3 sum(0.0f);
         for (int k = 0; k < centre.count; ++k) {
             const auto& [p, e1, e2] = centre.corner[k];
-            sum += vertices[e1] + vertices[e2] - vertices[p];
+            // A grid cell's quadrant ends at its parallelogram's fourth corner, a triangle's at its centroid.
+            sum += surface.mesh ? (2.0f * (vertices[e1] + vertices[e2]) - vertices[p]) / 3.0f : vertices[e1] + vertices[e2] - vertices[p];
         }
         vertices[first_centre + i] = sum / float(std::max(centre.count, 1));
     }

@@ -35,11 +35,12 @@ bool write_obj(const MassSpring& sim, const std::string& path, std::string& erro
     const bool grid = t.mesh || static_cast<std::size_t>(t.rows) * static_cast<std::size_t>(t.cols) == sim.particle_count();
     if (t.mesh) {
         for (const glm::vec2& texture : t.uv) out << "vt " << texture.x << ' ' << texture.y << '\n';
+        for (const glm::vec2& texture : surface.split_place) out << "vt " << texture.x << ' ' << texture.y << '\n';
     } else if (grid) {
         for (int r = 0; r < t.rows; ++r) {
             for (int c = 0; c < t.cols; ++c) uv(glm::vec2(float(c), float(r)));
         }
-        for (const glm::vec2& place : surface.split_grid) uv(place);
+        for (const glm::vec2& place : surface.split_place) uv(place);
     }
     auto corner = [&](std::uint32_t v) {
         out << ' ' << v + 1;

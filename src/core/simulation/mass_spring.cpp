@@ -62,8 +62,8 @@ MassSpring::MassSpring(Topology topology, State state, SimulationSettings settin
     rest_position_ = state_.position;  // the builder makes the cloth flat, at rest
     spacing_ = particle_spacing(topology_);
     in_->tethers = build_tethers(topology_, state_, rest_position_);
-    whole_cells_ = whole_cells(topology_, n);
-    surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
+    cells_at_start_ = cells_at_start(topology_, n);
+    surface_ = build_cloth_surface(topology_, rest_position_, cells_at_start_);
     replan();
     track_collider_motion();
     restart(initial_velocity.empty() ? std::vector<glm::dvec3>(n, glm::dvec3(0.0))
@@ -536,7 +536,7 @@ void MassSpring::topology_changed(std::size_t removed) {
     in_->invalidate_iterative();
     if (in_->self_collision) in_->self_collision->update_neighbours(topology_, rest_position_);
     rebuild_tethers();
-    surface_ = build_cloth_surface(topology_, rest_position_, whole_cells_);
+    surface_ = build_cloth_surface(topology_, rest_position_, cells_at_start_);
     replan();
     setup_stamp_ = next_stamp();
     topology_stamp_ = next_stamp();

@@ -4,6 +4,7 @@
 
 #include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/triangle_mesh.hpp"
 #include "collision/self_collision.hpp"
 #include "model/tearing.hpp"
 
@@ -14,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -60,6 +62,22 @@ double fold_share(const MassSpring& sim, const SelfCollision& stage, double d, c
     }
     for (const Bend& b : sim.topology().bends) pair(b.a, b.b);
     return least;
+}
+
+// The scene with its grid cloth given as a mesh cloth (cloth.mesh) of the same particles and triangles, the
+// vertices listed column by column: a mesh's runs of consecutive particles then lie across the grid's rows.
+Scene as_mesh_in_column_order(Scene scene) {
+    const MassSpring grid = build_simulation(scene);
+    const int rows = grid.topology().rows, cols = grid.topology().cols;
+    auto column_order = [&](std::uint32_t i) { return static_cast<std::uint32_t>((i % cols) * rows + i / cols); };
+    std::vector<glm::dvec3> vertices(grid.particle_count());
+    for (std::uint32_t i = 0; i < grid.particle_count(); ++i) vertices[column_order(i)] = grid.state().position.get(i);
+    std::vector<TriangleMesh::Triangle> triangles;
+    for (const auto& t : grid.topology().triangles) triangles.push_back({column_order(t[0]), column_order(t[1]), column_order(t[2])});
+    scene.cloth.mesh = "column-order.obj";
+    scene.cloth.mesh_data = std::make_shared<TriangleMesh>(std::move(vertices), std::move(triangles));
+    scene.cloth.origin = {0.0f, 0.0f, 0.0f};
+    return scene;
 }
 
 }  // namespace
@@ -343,4 +361,27 @@ TEST_CASE("self-collision: turned off and on again, it tests at its first subste
     const long long tiles = sim.profile().self_tiles;
     sim.substep();
     CHECK(sim.profile().self_tiles > tiles);
+}
+
+TEST_CASE("self-collision: a mesh cloth in pile and fold, listed column by column, keeps strangers half the "
+          "thickness apart and never crosses itself", "[self-collision]") {
+    for (const char* name : {"pile", "fold"}) {
+        MassSpring sim = build_simulation(as_mesh_in_column_order(load_scene(name)));
+        REQUIRE(sim.topology().mesh);
+        const SelfCollision springs_of(sim.topology(), sim.state().position);
+        const double d = springs_of.contact_distance(sim.settings().collision);
+        double closest = std::numeric_limits<double>::infinity();
+        std::size_t crossings = 0;
+        for (int step = 0; step < 150; ++step) {
+            sim.run_steps(1);
+            REQUIRE(sim.all_finite());
+            closest = std::min(closest, closest_strangers(sim, springs_of, d));
+            crossings += intersecting_triangle_pairs(sim.topology(), sim.positions());
+        }
+        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, "
+                  << sim.profile().self_contacts << " contacts");
+        CHECK(sim.profile().self_contacts > 1000);
+        CHECK(closest >= 0.5 * d);
+        CHECK(crossings == 0);
+    }
 }

@@ -53,15 +53,17 @@ double particle_spacing(const Topology& topology) {
 SelfCollision::SelfCollision(const Topology& topology, const DVec3Array& rest_position)
     : rows_(topology.rows), cols_(topology.cols), particles_(rest_position.size()) {
     grid_ = !topology.mesh && rows_ > 0 && cols_ > 0 && static_cast<std::size_t>(rows_) * cols_ == particles_;
+    spacing_ = particle_spacing(topology);
+    update_neighbours(topology, rest_position);
     if (grid_) {
         tile_rows_ = (rows_ + kSelfTile - 1) / kSelfTile;
         tile_cols_ = (cols_ + kSelfTile - 1) / kSelfTile;
     } else {
+        grow_patches();
         tile_rows_ = 1;
-        tile_cols_ = static_cast<int>((particles_ + kSelfTileParticles - 1) / kSelfTileParticles);
+        tile_cols_ = static_cast<int>(member_begin_.size() - 1);
+        link_patches();
     }
-    spacing_ = particle_spacing(topology);
-    update_neighbours(topology, rest_position);
     const std::size_t tiles = static_cast<std::size_t>(tile_rows_) * tile_cols_;
     order_.resize(tiles);
     tile_row_.resize(tiles);
@@ -181,6 +183,69 @@ void SelfCollision::update_neighbours(const Topology& topology, const DVec3Array
             longest_fold_kept_rest_[k] = std::max(longest_fold_kept_rest_[k], kept_rest);
         }
     }
+    // Each neighbour entry's fold share, so one search in a particle's short list tells both.
+    neighbour_fold_kept_.assign(neighbour_.size(), 0.0);
+    for (std::size_t k = 0; k < fold_pairs_.size(); ++k) {
+        const auto i = static_cast<std::uint32_t>(fold_pairs_[k] >> 32), j = static_cast<std::uint32_t>(fold_pairs_[k]);
+        for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}}) {
+            const auto from = neighbour_.begin() + neighbour_begin_[a], to = neighbour_.begin() + neighbour_begin_[a + 1];
+            const auto at = std::lower_bound(from, to, b);
+            if (at != to && *at == b) neighbour_fold_kept_[static_cast<std::size_t>(at - neighbour_.begin())] = fold_kept_rest_[k];
+        }
+    }
+    if (!grid_ && !particle_tile_.empty()) link_patches();  // a tear changed the links
+}
+
+double SelfCollision::link_of(std::uint32_t i, std::uint32_t j) const {
+    const auto begin = neighbour_.begin() + neighbour_begin_[i], end = neighbour_.begin() + neighbour_begin_[i + 1];
+    const auto at = std::lower_bound(begin, end, j);
+    if (at == end || *at != j) return -1.0;
+    return neighbour_fold_kept_[static_cast<std::size_t>(at - neighbour_.begin())];
+}
+
+void SelfCollision::grow_patches() {
+    // Breadth-first from the first particle not yet in a tile, over the links, until the tile is full.
+    constexpr std::uint32_t kNone = 0xffffffffu;
+    particle_tile_.assign(particles_, kNone);
+    member_begin_.assign(1, 0);
+    member_.clear();
+    member_.reserve(particles_);
+    for (std::size_t seed = 0; seed < particles_; ++seed) {
+        if (particle_tile_[seed] != kNone) continue;
+        const auto tile = static_cast<std::uint32_t>(member_begin_.size() - 1);
+        const std::size_t first = member_.size();
+        particle_tile_[seed] = tile;
+        member_.push_back(static_cast<std::uint32_t>(seed));
+        for (std::size_t head = first; head < member_.size() && member_.size() - first < kSelfTileParticles; ++head) {
+            const std::uint32_t i = member_[head];
+            for (std::uint32_t k = neighbour_begin_[i]; k < neighbour_begin_[i + 1]; ++k) {
+                const std::uint32_t j = neighbour_[k];
+                if (particle_tile_[j] != kNone || member_.size() - first >= kSelfTileParticles) continue;
+                particle_tile_[j] = tile;
+                member_.push_back(j);
+            }
+        }
+        member_begin_.push_back(static_cast<std::uint32_t>(member_.size()));
+    }
+}
+
+void SelfCollision::link_patches() {
+    // Neighbour patches: joined by a link (a spring, a bend, a hinge's pair).
+    const std::size_t tiles = member_begin_.size() - 1;
+    std::vector<std::vector<std::uint32_t>> joined(tiles);
+    for (std::size_t i = 0; i < particles_; ++i) {
+        for (std::uint32_t k = neighbour_begin_[i]; k < neighbour_begin_[i + 1]; ++k) {
+            const std::uint32_t a = particle_tile_[i], b = particle_tile_[neighbour_[k]];
+            if (a != b) joined[a].push_back(b);
+        }
+    }
+    tile_link_begin_.assign(1, 0);
+    tile_link_.clear();
+    for (std::uint32_t t = 0; t < tiles; ++t) {
+        std::sort(joined[t].begin(), joined[t].end());
+        tile_link_.insert(tile_link_.end(), joined[t].begin(), std::unique(joined[t].begin(), joined[t].end()));
+        tile_link_begin_.push_back(static_cast<std::uint32_t>(tile_link_.size()));
+    }
 }
 
 bool SelfCollision::neighbours(std::uint32_t i, std::uint32_t j) const {
@@ -203,6 +268,11 @@ bool SelfCollision::fold_pair(std::uint32_t i, std::uint32_t j) const {
 }
 
 double SelfCollision::kept_distance(std::uint32_t i, std::uint32_t j, double d, const DVec3Array& rest_position) const {
+    if (!grid_ || far_links_) {
+        const double link = link_of(i, j);
+        if (link >= 0.0) return link > 0.0 ? std::min(d, link) : 0.0;
+        return std::min(d, glm::length(rest_position.get(j) - rest_position.get(i)));
+    }
     const double rest = glm::length(rest_position.get(j) - rest_position.get(i));
     if (fold_pair(i, j)) return std::min(d, kSelfFoldShare * rest);
     return neighbours(i, j) ? 0.0 : std::min(d, rest);
@@ -213,12 +283,15 @@ double SelfCollision::contact_distance(const CollisionSettings& settings) const 
 }
 
 std::uint32_t SelfCollision::tile_of(std::uint32_t i) const {
-    if (!grid_) return i / kSelfTileParticles;
+    if (!grid_) return particle_tile_[i];
     const int r = static_cast<int>(i) / cols_, c = static_cast<int>(i) % cols_;
     return static_cast<std::uint32_t>((r / kSelfTile) * tile_cols_ + c / kSelfTile);
 }
 
 bool SelfCollision::adjacent_tiles(std::uint32_t a, std::uint32_t b) const {
+    if (!grid_) {
+        return a == b || std::binary_search(tile_link_.begin() + tile_link_begin_[a], tile_link_.begin() + tile_link_begin_[a + 1], b);
+    }
     return std::abs(tile_row_[a] - tile_row_[b]) <= 1 && std::abs(tile_col_[a] - tile_col_[b]) <= 1;
 }
 
@@ -232,7 +305,9 @@ void SelfCollision::tile_boxes(const DVec3Array& position) {
         box.hi = glm::max(box.hi, p);
     };
     if (!grid_) {
-        for (std::size_t i = 0; i < particles_; ++i) add(boxes_[i / kSelfTileParticles], i);
+        for (std::size_t t = 0; t + 1 < member_begin_.size(); ++t) {
+            for (std::uint32_t k = member_begin_[t]; k < member_begin_[t + 1]; ++k) add(boxes_[t], member_[k]);
+        }
         return;
     }
     for (int r = 0; r < rows_; ++r) {
@@ -335,6 +410,17 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
             active_[tile_of(i)] = active_[tile_of(j)] = 2;
         }
     }
+    // Off the grid every patch goes to the narrow phase with itself and its neighbour patches: a patch has the
+    // mesh's shape, not a square of the grid's, so its box and vector area cannot tell when it is folded or
+    // squeezed (an accordion buckle within one patch keeps more than half its vector area). Only far patches
+    // are left to the sweep.
+    for (std::uint32_t t = 0; !grid_ && t < tiles; ++t) {
+        if (active_[t] == 0) active_[t] = 1;
+        tile_pairs_.push_back(pair_key(t, t));
+        for (std::uint32_t k = tile_link_begin_[t]; k < tile_link_begin_[t + 1]; ++k) {
+            if (tile_link_[k] > t) tile_pairs_.push_back(pair_key(t, tile_link_[k]));
+        }
+    }
     const bool any_active = std::find_if(active_.begin(), active_.end(), [](std::uint8_t a) { return a != 0; }) != active_.end();
     // The budget: how much any two particles may close in before a test could find something new. When no
     // two particles close in by more than b, far boxes come b nearer at most, a diagonal shrinks by at most
@@ -371,12 +457,13 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
         if (!(budget > 0.0)) budget = 0.0;  // also NaN
         return 0;
     }
-    if (!(budget > 0.0)) budget = 0.0;
+    if (!(budget > 0.0) || !grid_) budget = 0.0;
     std::size_t count = 0;
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (active_[t] == 0) continue;
         ++count;
         if (active_[t] != 2) continue;
+        if (!grid_) continue;  // listed above, with all its neighbours
         const int r = tile_row_[t], c = tile_col_[t];
         for (int dr = -1; dr <= 1; ++dr) {
             for (int dc = -1; dc <= 1; ++dc) {
@@ -404,8 +491,7 @@ void SelfCollision::gather(std::uint32_t t, const State& state, TilePoints& out)
         ++n;
     };
     if (!grid_) {
-        const std::size_t begin = static_cast<std::size_t>(t) * kSelfTileParticles;
-        for (std::size_t i = begin; i < std::min(particles_, begin + kSelfTileParticles); ++i) add(i);
+        for (std::uint32_t k = member_begin_[t]; k < member_begin_[t + 1]; ++k) add(member_[k]);
     } else {
         const int r0 = tile_row_[t] * kSelfTile, c0 = tile_col_[t] * kSelfTile;
         for (int r = r0; r < std::min(rows_, r0 + kSelfTile); ++r) {
@@ -520,8 +606,14 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
                         const float x = B.x[v] - A.x[u], y = B.y[v] - A.y[u], z = B.z[v] - A.z[u];
                         if (!(x * x + y * y + z * z < fold_reach2[(dr + 2) * 5 + (dc + 2)])) continue;
                     }
-                } else if (neighbours(i, j) && !fold_pair(i, j)) {
-                    continue;
+                } else {
+                    const double fold_kept = link_of(i, j);
+                    if (fold_kept == 0.0) continue;  // neighbours
+                    if (fold_kept > 0.0) {  // a fold pair: listed within its kept distance plus its skin
+                        const double kept = std::min(d, fold_kept), reach = kept + fold_skin(kept, skin);
+                        const float x = B.x[v] - A.x[u], y = B.y[v] - A.y[u], z = B.z[v] - A.z[u];
+                        if (!(x * x + y * y + z * z < static_cast<float>(1.001 * reach * reach))) continue;
+                    }
                 }
                 candidates_.push_back(pair_key(i, j));
             }

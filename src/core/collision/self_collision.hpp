@@ -32,6 +32,9 @@
 //    Magnenat-Thalmann 1994's normal cone), or a tile alone or with a neighbour whose box diagonal falls
 //    under 0.8 of its rest diagonal (a box's diagonal is at least the distance between any two of its
 //    particles: an accordion buckle that leaves each tile's normal alone).
+// Off the grid (a mesh cloth) the tiles are patches of up to 16 particles grown breadth-first over the links,
+// neighbours when a link joins them; a patch's shape is the mesh's, so there is no fold test: every patch is
+// tested with itself and its neighbours at every test, and the sweep finds the far pairs.
 // The narrow phase compares every particle of one tile with every particle of the other (16 x 16, four at
 // a time in float), keeps the pairs that may touch (see the list below), and resolves them in index order
 // in double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.
@@ -130,12 +133,15 @@ private:
         int count = 0;
     };
 
-    int tile_rows_ = 0, tile_cols_ = 0;     // tiles of the grid (rows x cols), or one row of runs
-    bool grid_ = false;                     // false: tiles are runs of kSelfTile^2 particles along the list
+    int tile_rows_ = 0, tile_cols_ = 0;     // tiles of the grid (rows x cols), or one row of patches
+    bool grid_ = false;                     // false: tiles are patches grown over the links (below)
     int rows_ = 0, cols_ = 0;
     std::size_t particles_ = 0;
     double spacing_ = 0.0;                  // m: the longest structural rest length
     std::vector<std::uint32_t> neighbour_begin_, neighbour_;  // sorted spring neighbours of each particle
+    std::vector<double> neighbour_fold_kept_;  // per entry of neighbour_: its fold pair's kept rest, else 0
+    // Off the grid: -1 for strangers, 0 for neighbours, else the fold pair's fold_kept_rest_ (one search).
+    double link_of(std::uint32_t i, std::uint32_t j) const;
     std::vector<std::uint32_t> near_mask_;  // grid: bit (dr + 2) * 5 + dc + 2 set for a neighbour at (dr, dc)
     bool far_links_ = false;                // grid: some link spans more than two rows or columns
     std::vector<std::uint64_t> fold_pairs_;   // (i << 32 | j), i < j: the fold pairs (sorted off the grid)
@@ -151,6 +157,11 @@ private:
     std::vector<std::array<std::uint32_t, 4>> corner_;  // grid: each tile's corner particles (00, 0c, r0, rc)
     std::vector<float> rest_area_;          // grid: twice each tile's rest area, |vector_area| as built
     std::vector<float> tile_rest_;          // grid, per tile: rest diagonals of it alone and with 4 neighbours
+    // Off the grid (a mesh cloth): each tile a patch of up to kSelfTile^2 particles grown breadth-first over
+    // the links, so compact on the cloth whatever the particles' order; tiles joined by a link are neighbours.
+    std::vector<std::uint32_t> member_begin_, member_;           // each tile's particles
+    std::vector<std::uint32_t> particle_tile_;                   // each particle's tile
+    std::vector<std::uint32_t> tile_link_begin_, tile_link_;     // each tile's neighbour tiles, sorted
     // Scratch, kept between substeps.
     std::vector<Box> boxes_;
     std::vector<std::uint32_t> order_;      // tiles sorted by box.lo.x (the last substep's order)
@@ -171,6 +182,9 @@ private:
     double tested_distance_ = 0.0;          // the d the last test was made for (0: none, test at the next substep)
 
     bool adjacent_tiles(std::uint32_t a, std::uint32_t b) const;
+    // Off the grid: the patches (once, from the links), then their neighbours (again whenever the links change).
+    void grow_patches();
+    void link_patches();
     std::uint32_t tile_of(std::uint32_t particle) const;
     void tile_boxes(const DVec3Array& position);
     // Lists the tile pairs the narrow phase tests: far tiles within d + skin of each other, and each folded

@@ -370,18 +370,31 @@ TEST_CASE("self-collision: a mesh cloth in pile and fold, listed column by colum
         REQUIRE(sim.topology().mesh);
         const SelfCollision springs_of(sim.topology(), sim.state().position);
         const double d = springs_of.contact_distance(sim.settings().collision);
-        double closest = std::numeric_limits<double>::infinity();
+        const DVec3Array rest = sim.state().position;  // built flat, at rest
+        // Each hinge's far corners are a fold pair: down to what share of their kept distance they came.
+        auto fold_share = [&] {
+            double least = std::numeric_limits<double>::infinity();
+            for (const Hinge& h : sim.topology().hinges) {
+                REQUIRE(springs_of.fold_pair(h.v[2], h.v[3]));
+                least = std::min(least, glm::length(sim.state().position.get(h.v[3]) - sim.state().position.get(h.v[2])) /
+                                            springs_of.kept_distance(h.v[2], h.v[3], d, rest));
+            }
+            return least;
+        };
+        double closest = std::numeric_limits<double>::infinity(), closest_fold = closest;
         std::size_t crossings = 0;
         for (int step = 0; step < 150; ++step) {
             sim.run_steps(1);
             REQUIRE(sim.all_finite());
             closest = std::min(closest, closest_strangers(sim, springs_of, d));
+            closest_fold = std::min(closest_fold, fold_share());
             crossings += intersecting_triangle_pairs(sim.topology(), sim.positions());
         }
-        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, "
-                  << sim.profile().self_contacts << " contacts");
+        INFO(name << ": contact distance " << d << " m, closest strangers " << closest << " m, fold pairs down to "
+                  << closest_fold << " of their kept distance, " << sim.profile().self_contacts << " contacts");
         CHECK(sim.profile().self_contacts > 1000);
         CHECK(closest >= 0.5 * d);
+        CHECK(closest_fold >= 0.5);
         CHECK(crossings == 0);
     }
 }

@@ -399,7 +399,9 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     // distance shrinks by at most the closing.
     double fold_margin = std::numeric_limits<double>::infinity();
     double least_fold_skin = std::numeric_limits<double>::infinity();  // bounds the budget when listing
-    for (std::size_t k = 0; k < fold_pairs_.size(); ++k) {
+    // (Off the grid every patch is in the narrow phase and a fold pair is listed out to its kept distance plus
+    // the whole skin: the skin alone bounds the budget.)
+    for (std::size_t k = 0; grid_ && k < fold_pairs_.size(); ++k) {
         const auto i = static_cast<std::uint32_t>(fold_pairs_[k] >> 32), j = static_cast<std::uint32_t>(fold_pairs_[k]);
         const double kept = std::min(double(d), fold_kept_rest_[k]);
         const double margin = glm::length(position.get(j) - position.get(i)) - kept;
@@ -457,7 +459,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
         if (!(budget > 0.0)) budget = 0.0;  // also NaN
         return 0;
     }
-    if (!(budget > 0.0) || !grid_) budget = 0.0;
+    if (!(budget > 0.0)) budget = 0.0;
     std::size_t count = 0;
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (active_[t] == 0) continue;
@@ -609,8 +611,8 @@ SelfCollisionCounts SelfCollision::collide(State& state, const CollisionSettings
                 } else {
                     const double fold_kept = link_of(i, j);
                     if (fold_kept == 0.0) continue;  // neighbours
-                    if (fold_kept > 0.0) {  // a fold pair: listed within its kept distance plus its skin
-                        const double kept = std::min(d, fold_kept), reach = kept + fold_skin(kept, skin);
+                    if (fold_kept > 0.0) {  // a fold pair: listed within its kept distance plus its skin (all of it off the grid)
+                        const double kept = std::min(d, fold_kept), reach = kept + (grid_ ? fold_skin(kept, skin) : skin);
                         const float x = B.x[v] - A.x[u], y = B.y[v] - A.y[u], z = B.z[v] - A.z[u];
                         if (!(x * x + y * y + z * z < static_cast<float>(1.001 * reach * reach))) continue;
                     }

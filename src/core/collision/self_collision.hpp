@@ -34,7 +34,8 @@
 //    particles: an accordion buckle that leaves each tile's normal alone).
 // Off the grid (a mesh cloth) the tiles are patches of up to 16 particles grown breadth-first over the links,
 // neighbours when a link joins them; a patch's shape is the mesh's, so there is no fold test: every patch is
-// tested with itself and its neighbours at every test, and the sweep finds the far pairs.
+// tested with itself and its neighbours at every test, the sweep finds the far pairs, and a fold pair is
+// listed out to its kept distance plus the whole skin (the skin is the budget).
 // The narrow phase compares every particle of one tile with every particle of the other (16 x 16, four at
 // a time in float), keeps the pairs that may touch (see the list below), and resolves them in index order
 // in double (Gauss-Seidel, one pass a substep), so the result does not depend on the order of the tiles.

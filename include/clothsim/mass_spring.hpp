@@ -116,9 +116,9 @@ public:
     // A mesh cloth on the fast method: its springs and hinges, integration and tethers run on the work team, on
     // this many threads (0: not on the team).
     int mesh_team_threads() const;
-    // Whether the last substep ran on the fast path: the fast solver (Verlet), or XPBD's grid form
-    // (grid_xpbd.hpp: xpbd with solver.method = "fast" on a grid cloth) or its coloured form (coloured_xpbd.hpp:
-    // the same on a mesh cloth).
+    // Whether the last substep ran on the fast path: the fast solver (Verlet on a grid cloth) or the element
+    // gather (element_gather.hpp: Verlet on a mesh cloth), or XPBD's grid form (grid_xpbd.hpp: xpbd with
+    // solver.method = "fast" on a grid cloth) or its coloured form (coloured_xpbd.hpp: the same on a mesh cloth).
     bool last_step_fast() const;
     // Tethers to the pins (tethers.hpp; they act when springs.tether_strain > 0), and how many were at their
     // limit in the last substep.

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
+#include <string_view>
 #include <type_traits>
 #include <variant>
 
@@ -875,15 +876,19 @@ void stats_section(const AppState& app) {
         ImGui::Text("%zu particles, %zu springs, t = %.2f s", app.sim.particle_count(), app.sim.spring_count(),
                     app.sim.time());
     }
-    // The fast path runs position Verlet (the fast solver) and XPBD (its grid form, or on a mesh cloth its
-    // coloured form, scalar); every other integrator uses the shared textbook force path.
+    // The fast path runs position Verlet (the fast solver, or on a mesh cloth the element gather) and XPBD (its
+    // grid form, or on a mesh cloth its coloured form); every other integrator uses the shared textbook force path.
     const bool fast = app.sim.last_step_fast();
+    const bool wide = std::string_view(MassSpring::fast_kernel_name()) == "avx512";
+    const char* form = !app.sim.topology().mesh                                       ? MassSpring::fast_kernel_name()
+                       : app.sim.settings().integration.integrator == Integrator::Xpbd ? (wide ? "colours, avx512" : "colours")
+                       : wide                                                          ? "element gather, avx512"
+                                                                                       : "element gather";
     const double per_substep_us = app.stats.substeps_last_frame > 0
                                       ? 1000.0 * app.stats.sim_ms / double(app.stats.substeps_last_frame)
                                       : 0.0;
     if (fast) {
-        ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep",
-                    app.sim.topology().mesh ? "colours" : MassSpring::fast_kernel_name(), app.sim.solver_threads(),
+        ImGui::Text("solver: fast, %s, %d thread%s: %.1f us/substep", form, app.sim.solver_threads(),
                     app.sim.solver_threads() == 1 ? "" : "s", per_substep_us);
     } else {
         ImGui::Text("solver: textbook, 1 thread: %.1f us/substep", per_substep_us);

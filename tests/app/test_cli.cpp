@@ -112,6 +112,14 @@ TEST_CASE("cli: --json says which solver ran and, for implicit Euler and XPBD, t
     // CG stops once the relative residual is under the tolerance (or at its iteration cap, far away here).
     CHECK(implicit.at("residual").get<double>() <= 1e-4);
     CHECK(implicit.at("residual").get<double>() >= 0.0);
+    // A mesh cloth's Verlet runs its springs and hinges as the element gather on the work team: the fast path.
+    const RunResult mesh = run_clothsim({"--headless", "--scene", "skirt", "--steps", "2", "--set", "solver.threads=2", "--json"});
+    CAPTURE_RUN(mesh);
+    REQUIRE(mesh.code == 0);
+    const nlohmann::json gather = nlohmann::json::parse(mesh.out).at("solver");
+    CHECK(gather.at("integrator") == "verlet");
+    CHECK(gather.at("path") == "fast");
+    CHECK(gather.at("threads") == 2);
     // XPBD runs its grid form on the fast path (grid_xpbd.hpp), and the list order when the textbook is asked for.
     for (const char* method : {"fast", "textbook"}) {
         const RunResult x = run_clothsim({"--headless", "--steps", "2", "--set", "cloth.rows=12", "--set",

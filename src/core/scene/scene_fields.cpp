@@ -81,7 +81,7 @@ const std::array kFields = {
     FieldInfo{"integration.iterations", "", 1, 1000, "projective: the most quasi-Newton iterations per substep (each one solve with the prefactorised matrix)", [](Scene& s) -> FieldRef { return &s.settings.integration.iterations; }},
 
     FieldInfo{"solver.method", "", 0, 0, "fast: vectorised multi-threaded row sweeps; textbook: spring-list loop (the test oracle)", [](Scene& s) -> FieldRef { return &s.settings.solver.method; }},
-    FieldInfo{"solver.threads", "", 0, 64, "threads of the fast path (fast solver, grid and coloured XPBD, collision tests); 0 = one per core, or one while that is faster; results are identical for any count", [](Scene& s) -> FieldRef { return &s.settings.solver.threads; }},
+    FieldInfo{"solver.threads", "", 0, 64, "threads of the fast path (fast solver, a mesh cloth's element gather, grid and coloured XPBD, collision tests); 0 = one per core, or one while that is faster; results are identical for any count", [](Scene& s) -> FieldRef { return &s.settings.solver.threads; }},
     FieldInfo{"solver.broad_phase", "", 0, 0, "test a collider only on particle blocks whose bounds meet it (results are identical; false tests every particle)", [](Scene& s) -> FieldRef { return &s.settings.solver.broad_phase; }},
     FieldInfo{"solver.sleep_speed", "m/s", 0, 10, "0 = never sleep; else the cloth sleeps once every free particle stays slower than this for sleep_time with still air", [](Scene& s) -> FieldRef { return &s.settings.solver.sleep_speed; }},
     FieldInfo{"solver.sleep_time", "s", 0, 1e4, "how long the cloth must stay under sleep_speed before it sleeps", [](Scene& s) -> FieldRef { return &s.settings.solver.sleep_time; }},

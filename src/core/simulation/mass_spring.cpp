@@ -136,6 +136,7 @@ int MassSpring::solver_threads() const {
 
 bool MassSpring::last_step_fast() const {
     if (plan_.path == StepPath::FastVerlet) return true;
+    if (plan_.path == StepPath::TextbookVerlet && mesh_team_threads() > 0) return true;  // the element gather
     return settings_.integration.integrator == Integrator::Xpbd && state_.integrator == Integrator::Xpbd &&
            (in_->iterative.grid_xpbd_ran || in_->iterative.coloured_xpbd_ran);
 }

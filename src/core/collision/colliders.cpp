@@ -381,12 +381,8 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
             // bands): 1024 particles, the pieces of the mesh's other stages, so each thread boxes the particles
             // it has just moved. Each box is its block's alone: the same boxes on any number of threads.
             constexpr std::size_t kPieceBlocks = 64;
-            const int pieces = static_cast<int>((count + kPieceBlocks - 1) / kPieceBlocks);
-            if (threads > 1 && pieces > 1) {
-                WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
-                    const std::size_t first = static_cast<std::size_t>(piece) * kPieceBlocks;
-                    box_range(first, std::min(count, first + kPieceBlocks));
-                });
+            if (threads > 1 && WorkTeam::pieces(count, kPieceBlocks) > 1) {
+                WorkTeam::shared().run_pieces(threads, count, kPieceBlocks, box_range);
             } else {
                 box_range(0, count);
             }

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <thread>
@@ -48,6 +49,18 @@ public:
         using W = std::remove_reference_t<Work>;
         run_job(threads, count, &work, [](void* w, int index, int worker) { (*static_cast<W*>(w))(index, worker); });
     }
+
+    // Calls work(first, last) for the pieces [first, last) of `piece` items each that cover [0, items), through
+    // run(): the same pieces, each its own work, on any number of threads.
+    template <class Work>
+    void run_pieces(int threads, std::size_t items, std::size_t piece, Work&& work) {
+        run(threads, pieces(items, piece), [&](int index, int) {
+            const std::size_t first = static_cast<std::size_t>(index) * piece;
+            work(first, first + piece < items ? first + piece : items);
+        });
+    }
+    // How many pieces of `piece` items cover `items`.
+    static int pieces(std::size_t items, std::size_t piece) { return static_cast<int>((items + piece - 1) / piece); }
 
     // The hardware threads of this machine, read once.
     static int cores();

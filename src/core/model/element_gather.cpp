@@ -19,7 +19,6 @@ constexpr std::size_t kPiece = 1024;
 constexpr std::size_t kLanes = 16;
 static_assert(kPiece % kLanes == 0);
 
-int pieces(std::size_t count) { return static_cast<int>((count + kPiece - 1) / kPiece); }
 
 }  // namespace
 
@@ -206,7 +205,7 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
                           const SpringSettings& springs, Vec3Array& force, int threads) {
     using Vec = glm::vec3;
     WorkTeam& team = WorkTeam::shared();
-    const int spring_pieces = pieces(g.springs), hinge_pieces = pieces(g.hinges);
+    const int spring_pieces = WorkTeam::pieces(g.springs, kPiece), hinge_pieces = WorkTeam::pieces(g.hinges, kPiece);
     // Each element's force, as accumulate_spring_forces computes it (an element it skips gets zero, which adds
     // nothing: a sum that starts at +0 never becomes -0).
     const bool wide = FastSolver::kernel() == FastKernel::Avx512;
@@ -249,8 +248,7 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
     // Each particle's sum, in list order: sixteen particles at a time with the AVX-512 kernel (FastSolver's
     // choice, so the tests run every kernel the CPU has), else one at a time.
     const std::size_t n = g.begin.size() - 1;
-    team.run(threads, pieces(n), [&](int piece, int) {
-        const std::size_t first = static_cast<std::size_t>(piece) * kPiece, last = std::min(n, first + kPiece);
+    team.run_pieces(threads, n, kPiece, [&](std::size_t first, std::size_t last) {
         if (wide) {
             sum_avx512(g, first, last, force);
             return;

@@ -397,12 +397,8 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
     {
         StageTimer timer(profile, Stage::Integrate);
         if (const int threads = mesh_team_threads(); threads > 0) {
-            const std::size_t n = state_.size();
-            const int pieces = static_cast<int>((n + kTeamPiece - 1) / kTeamPiece);
-            WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
-                const std::size_t first = static_cast<std::size_t>(piece) * kTeamPiece;
-                integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h, first,
-                                 std::min(n, first + kTeamPiece));
+            WorkTeam::shared().run_pieces(threads, state_.size(), kTeamPiece, [&](std::size_t first, std::size_t last) {
+                integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h, first, last);
             });
             state_.substep = h;
         } else {
@@ -424,16 +420,12 @@ std::size_t MassSpring::apply_tethers(const BlockBounds* boxes) {
     const double strain = settings_.springs.tether_strain;
     if (const int threads = mesh_team_threads(); threads > 0 && plan_.path == StepPath::TextbookVerlet) {
         // A mesh cloth's tethers in pieces of particles on the team (sorted by particle: a piece's are a run).
-        const std::size_t n = state_.size();
-        const int pieces = static_cast<int>((n + kTeamPiece - 1) / kTeamPiece);
         std::vector<std::size_t>& active = in_->tether_pieces;
-        active.assign(static_cast<std::size_t>(pieces), 0);
-        WorkTeam::shared().run(threads, pieces, [&](int piece, int) {
-            const auto first = static_cast<std::uint32_t>(static_cast<std::size_t>(piece) * kTeamPiece);
-            const auto last = static_cast<std::uint32_t>(std::min(n, static_cast<std::size_t>(first) + kTeamPiece));
-            active[static_cast<std::size_t>(piece)] = project_tethers(state_, in_->tethers, strain,
-                                                                      first_tether_from(in_->tethers, first),
-                                                                      first_tether_from(in_->tethers, last));
+        active.assign(static_cast<std::size_t>(WorkTeam::pieces(state_.size(), kTeamPiece)), 0);
+        WorkTeam::shared().run_pieces(threads, state_.size(), kTeamPiece, [&](std::size_t first, std::size_t last) {
+            active[first / kTeamPiece] = project_tethers(state_, in_->tethers, strain,
+                                                         first_tether_from(in_->tethers, static_cast<std::uint32_t>(first)),
+                                                         first_tether_from(in_->tethers, static_cast<std::uint32_t>(last)));
         });
         std::size_t total = 0;
         for (std::size_t a : active) total += a;

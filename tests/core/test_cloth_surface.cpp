@@ -1,5 +1,6 @@
 // The surface of a torn cloth (cloth_surface.hpp): split along the tears, so that a cut shows as a seam
 // and an opened tear as a crack, never as a missing row of cells, and no triangle spans a broken spring.
+#include "split_obj.hpp"
 #include "support.hpp"
 
 #include "clothsim/cloth_mesh_shapes.hpp"
@@ -88,6 +89,62 @@ double piece_area(const MassSpring& sim, const std::vector<glm::vec3>& v, std::u
     return sum;
 }
 
+// Cuts particle `lone` free and checks the surface keeps `patch` m^2 of cloth around it and `rest` for the piece of
+// particle 0, the pieces' surfaces apart.
+void check_cut_free(MassSpring& sim, std::uint32_t lone, double patch, double rest) {
+    const glm::vec3 p = sim.position(lone);
+    REQUIRE(sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a == p) != (b == p); }) > 0);
+    for (const Spring& sp : sim.topology().springs) CHECK((sp.a != lone && sp.b != lone));
+    const std::vector<glm::vec3> v = surface_vertices(sim);
+    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
+    REQUIRE(piece[lone] != piece[0]);
+    CHECK(piece_area(sim, v, piece[lone]) == Approx(patch).epsilon(1e-5));
+    CHECK(piece_area(sim, v, piece[0]) == Approx(rest).epsilon(1e-5));
+    check_surface_respects_the_tears(sim);
+}
+
+// The split surface's area; every triangle of it faces `facing` (+1 or -1) along y, as the cloth's own
+// triangles on a flat cloth in a plane y = const.
+double surface_area(const ClothSurface& s, const std::vector<glm::vec3>& v, float facing) {
+    double total = 0.0;
+    for (const auto& t : s.triangles) {
+        total += area(v, t);
+        const glm::vec3 n = glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
+        CHECK(facing * n.y > 0.0f);
+    }
+    return total;
+}
+
+// On a cloth cut while flat: the two ends of each broken edge have points of their own, which coincide (at the
+// edge's middle). Returns how many such pairs there are.
+std::size_t seam_pairs(const ClothSurface& s, const std::vector<glm::vec3>& v) {
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
+        for (std::size_t j = i + 1; j < s.edge_points.size(); ++j) {
+            const auto &a = s.edge_points[i], &b = s.edge_points[j];
+            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
+            ++pairs;
+            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) < 1e-6f);
+            CHECK(glm::length(v[s.particles + i] - 0.5f * (v[a.from] + v[a.to])) < 1e-6f);
+        }
+    }
+    return pairs;
+}
+
+// Within a piece nothing is split: the only vertices that coincide belong to different pieces (the two ends of a
+// broken edge, the centres of a torn cell's pieces). A held edge's middle made twice, or a piece's corners each
+// with a centre of their own, would coincide within one piece.
+void check_coinciding_vertices_part(const MassSpring& sim, const std::vector<glm::vec3>& v) {
+    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        for (std::size_t j = i + 1; j < v.size(); ++j) {
+            if (glm::length(v[i] - v[j]) > 1e-6f) continue;
+            INFO("vertices " << i << " and " << j << " coincide");
+            CHECK(piece[i] != piece[j]);
+        }
+    }
+}
+
 // Cuts every spring that crosses the plane z = 0.35 (between rows 3 and 4).
 std::size_t cut_between_rows_3_and_4(MassSpring& sim) {
     return sim.cut([](glm::vec3 a, glm::vec3 b) { return (a.z - 0.35f) * (b.z - 0.35f) < 0.0f; });
@@ -139,39 +196,14 @@ TEST_CASE("cloth surface: a straight cut through a flat cloth is a closed seam: 
     REQUIRE(s.split());
     const std::vector<glm::vec3> v = surface_vertices(sim);
     REQUIRE(v.size() == s.vertex_count());
-    double total = 0.0;
-    for (const auto& t : s.triangles) {
-        total += area(v, t);
-        const glm::vec3 n = glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
-        CHECK(n.y < 0.0f);  // counter-clockwise seen from u x v, as the topology's triangles
-    }
-    // Dropping the torn cells' triangles would leave 0.7 x 0.1 m^2 out.
-    CHECK(total == Approx(whole).epsilon(1e-5));
-    // The two ends of each broken edge have points of their own, and on the uncut flat cloth they coincide.
-    std::size_t pairs = 0;
-    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
-        for (std::size_t j = i + 1; j < s.edge_points.size(); ++j) {
-            const auto &a = s.edge_points[i], &b = s.edge_points[j];
-            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
-            ++pairs;
-            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) < 1e-6f);
-        }
-    }
-    CHECK(pairs == kSide);  // one per column: the vertical springs the cut crossed
+    // Counter-clockwise seen from u x v (-y), as the topology's triangles. Dropping the torn cells' triangles
+    // would leave 0.7 x 0.1 m^2 out.
+    CHECK(surface_area(s, v, -1.0f) == Approx(whole).epsilon(1e-5));
+    CHECK(seam_pairs(s, v) == kSide);  // one per column: the vertical springs the cut crossed
     // The 7 torn cells of row 3: 8 x 2 ends of broken edges and 2 x 7 held edges' middles; two pieces each.
     CHECK(s.edge_points.size() == 30);
     CHECK(s.centres.size() == 14);
-    // Within a piece nothing is split: the only vertices that coincide belong to different pieces (the two
-    // ends of a broken edge, the centres of a torn cell's two pieces). A held edge's middle made twice, or a
-    // piece's corners each with a centre of their own, would coincide within one piece.
-    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
-    for (std::size_t i = 0; i < v.size(); ++i) {
-        for (std::size_t j = i + 1; j < v.size(); ++j) {
-            if (glm::length(v[i] - v[j]) > 1e-6f) continue;
-            INFO("vertices " << i << " and " << j << " coincide");
-            CHECK(piece[i] != piece[j]);
-        }
-    }
+    check_coinciding_vertices_part(sim, v);
     check_surface_respects_the_tears(sim);
 }
 
@@ -286,16 +318,7 @@ TEST_CASE("cloth surface: an opened cut is a crack as wide as the pieces parted,
 
 TEST_CASE("cloth surface: a particle cut free keeps its own patch, one cell of cloth around it", "[tearing]") {
     MassSpring sim = flat_cloth();
-    const std::size_t lone = 3 * kSide + 3;
-    const glm::vec3 p = sim.position(lone);
-    REQUIRE(sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a == p) != (b == p); }) > 0);
-    for (const Spring& sp : sim.topology().springs) CHECK((sp.a != lone && sp.b != lone));
-    const std::vector<glm::vec3> v = surface_vertices(sim);
-    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
-    REQUIRE(piece[lone] != piece[0]);
-    CHECK(piece_area(sim, v, piece[lone]) == Approx(kSpacing * kSpacing).epsilon(1e-5));
-    CHECK(piece_area(sim, v, piece[0]) == Approx(0.49 - kSpacing * kSpacing).epsilon(1e-5));
-    check_surface_respects_the_tears(sim);
+    check_cut_free(sim, 3 * kSide + 3, kSpacing * kSpacing, 0.49 - kSpacing * kSpacing);
 }
 
 TEST_CASE("cloth surface: a tear pulled open keeps every triangle within one piece", "[tearing]") {
@@ -332,37 +355,13 @@ TEST_CASE("cloth surface: a mesh cloth cut along a chord is a closed seam, as th
     CHECK(s.mesh);
     const std::vector<glm::vec3> v = surface_vertices(sim);
     REQUIRE(v.size() == s.vertex_count());
-    double total = 0.0;
-    for (const auto& t : s.triangles) {
-        total += area(v, t);
-        const glm::vec3 n = glm::cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
-        CHECK(facing * n.y > 0.0f);  // wound as the mesh's own triangles
-    }
+    const double total = surface_area(s, v, facing);  // wound as the mesh's own triangles
     // Dropping the triangles that lost an edge would leave a strip along the chord out; each torn triangle is
     // drawn as six triangles about its centroid, which tile it.
     CHECK(total == Approx(whole).epsilon(1e-5));
     CHECK(triangles_area(sim) < 0.95 * whole);
-    // Each broken edge has a point at each end, and on the flat cloth they coincide at its middle.
-    std::size_t pairs = 0;
-    for (std::size_t i = 0; i < s.edge_points.size(); ++i) {
-        for (std::size_t j = i + 1; j < s.edge_points.size(); ++j) {
-            const auto &a = s.edge_points[i], &b = s.edge_points[j];
-            if (a.whole || b.whole || a.from != b.to || a.to != b.from) continue;
-            ++pairs;
-            CHECK(glm::length(v[s.particles + i] - v[s.particles + j]) < 1e-6f);
-            CHECK(glm::length(v[s.particles + i] - 0.5f * (v[a.from] + v[a.to])) < 1e-6f);
-        }
-    }
-    CHECK(pairs == broken);
-    // Vertices that coincide belong to different pieces: nothing is split within one.
-    const std::vector<std::uint32_t> piece = vertex_pieces(sim);
-    for (std::size_t i = 0; i < v.size(); ++i) {
-        for (std::size_t j = i + 1; j < v.size(); ++j) {
-            if (glm::length(v[i] - v[j]) > 1e-6f) continue;
-            INFO("vertices " << i << " and " << j << " coincide");
-            CHECK(piece[i] != piece[j]);
-        }
-    }
+    CHECK(seam_pairs(s, v) == broken);
+    check_coinciding_vertices_part(sim, v);
     check_surface_respects_the_tears(sim);
 }
 
@@ -374,16 +373,7 @@ TEST_CASE("cloth surface: a mesh vertex cut free keeps its own patch, a third of
     for (const auto& t : sim.topology().triangles) {
         if (t[0] == lone || t[1] == lone || t[2] == lone) patch += area(before, t) / 3.0;
     }
-    const double whole = triangles_area(sim);
-    const glm::vec3 p = sim.position(lone);
-    REQUIRE(sim.cut([&](glm::vec3 a, glm::vec3 b) { return (a == p) != (b == p); }) > 0);
-    for (const Spring& sp : sim.topology().springs) CHECK((sp.a != lone && sp.b != lone));
-    const std::vector<glm::vec3> v = surface_vertices(sim);
-    const std::vector<std::uint32_t> piece = connected_pieces(sim.topology(), sim.particle_count());
-    REQUIRE(piece[lone] != piece[0]);
-    CHECK(piece_area(sim, v, piece[lone]) == Approx(patch).epsilon(1e-5));
-    CHECK(piece_area(sim, v, piece[0]) == Approx(whole - patch).epsilon(1e-5));
-    check_surface_respects_the_tears(sim);
+    check_cut_free(sim, lone, patch, triangles_area(sim) - patch);
 }
 
 TEST_CASE("cloth surface: a torn mesh cloth falling apart keeps every triangle within one piece, and its OBJ has "
@@ -409,30 +399,5 @@ TEST_CASE("cloth surface: a torn mesh cloth falling apart keeps every triangle w
     split_surface_normals(s, v, normals);
     for (const glm::vec3& n : normals) CHECK(glm::length(n) == Approx(1.0f).epsilon(1e-5));
     // The OBJ: the split surface with a texture coordinate for every vertex, faces naming both.
-    const std::string path =
-        (std::filesystem::temp_directory_path() / ("clothsim-torn-mesh-" + std::to_string(::getpid()) + ".obj")).string();
-    std::string error;
-    REQUIRE(write_obj(sim, path, error));
-    std::ifstream in(path);
-    std::size_t faces = 0, vertices = 0, uvs = 0;
-    bool indices_in_range = true;
-    for (std::string line; std::getline(in, line);) {
-        vertices += line.rfind("v ", 0) == 0 ? 1 : 0;
-        uvs += line.rfind("vt ", 0) == 0 ? 1 : 0;
-        if (line.rfind("f ", 0) != 0) continue;
-        ++faces;
-        std::istringstream f(line.substr(2));
-        for (std::string corner; f >> corner;) {
-            const std::size_t slash = corner.find('/');
-            REQUIRE(slash != std::string::npos);
-            const std::size_t index = std::stoul(corner.substr(0, slash)), texture = std::stoul(corner.substr(slash + 1));
-            indices_in_range = indices_in_range && index >= 1 && index <= s.vertex_count() && texture == index;
-        }
-    }
-    in.close();
-    std::filesystem::remove(path);
-    CHECK(faces == s.triangles.size());
-    CHECK(vertices == s.vertex_count());
-    CHECK(uvs == s.vertex_count());
-    CHECK(indices_in_range);
+    test::check_obj_is_the_split_surface(sim);
 }

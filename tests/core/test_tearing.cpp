@@ -1,4 +1,5 @@
 // Tearing (tearing.hpp): springs beyond springs.tear_strain break, once per step.
+#include "split_obj.hpp"
 #include "support.hpp"
 
 #include "clothsim/export.hpp"
@@ -116,33 +117,8 @@ TEST_CASE("tearing: no triangle spans a torn spring, in the topology and in the 
         CHECK(has_spring(t, tri[1], tri[2]));
         CHECK(has_spring(t, tri[2], tri[0]));
     }
-    const std::string path =
-        (std::filesystem::temp_directory_path() / ("clothsim-torn-" + std::to_string(::getpid()) + ".obj")).string();
-    std::string error;
-    REQUIRE(write_obj(sim, path, error));
     // The export is the split surface (cloth_surface.hpp): its vertices, UVs and triangles.
-    const ClothSurface& surface = sim.surface();
-    REQUIRE(surface.split());
-    std::ifstream in(path);
-    std::size_t faces = 0, vertices = 0, uvs = 0;
-    bool indices_in_range = true;
-    for (std::string line; std::getline(in, line);) {
-        vertices += line.rfind("v ", 0) == 0 ? 1 : 0;
-        uvs += line.rfind("vt ", 0) == 0 ? 1 : 0;
-        if (line.rfind("f ", 0) != 0) continue;
-        ++faces;
-        std::istringstream f(line.substr(2));
-        for (std::string corner; f >> corner;) {
-            const std::size_t index = std::stoul(corner.substr(0, corner.find('/')));
-            indices_in_range = indices_in_range && index >= 1 && index <= surface.vertex_count();
-        }
-    }
-    in.close();
-    std::filesystem::remove(path);
-    CHECK(faces == surface.triangles.size());
-    CHECK(vertices == surface.vertex_count());
-    CHECK(uvs == surface.vertex_count());
-    CHECK(indices_in_range);
+    test::check_obj_is_the_split_surface(sim);
 }
 
 TEST_CASE("tearing: off at tear_strain 0, and the plan says so", "[tearing]") {

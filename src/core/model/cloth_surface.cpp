@@ -49,6 +49,73 @@ std::vector<std::uint8_t> drawn_cells(const Topology& topology, std::size_t part
     return drawn;
 }
 
+// The split surface's edge points, each made once: one per held edge, shared by its two cells, and one per end
+// of a broken edge. `back(from, to)` (the particle the end's own row continues from) and `place(from, to)` (for
+// its UV) are asked only of a new one.
+class EdgePoints {
+public:
+    EdgePoints(ClothSurface& surface, const DVec3Array& rest) : surface_(surface), rest_(rest) {}
+    template <class Back, class Place>
+    std::uint32_t get(std::uint32_t from, std::uint32_t to, bool whole, Back&& back, Place&& place) {
+        const std::uint64_t key = whole ? pair_key(from, to) : ((static_cast<std::uint64_t>(from) << 32) | to);
+        const auto found = made_.find(key);
+        if (found != made_.end()) return found->second;
+        ClothSurface::EdgePoint e;
+        e.from = from;
+        e.to = to;
+        e.whole = whole;
+        e.back = whole ? ClothSurface::kNoParticle : back(from, to);
+        e.half_rest = static_cast<float>(0.5 * glm::length(rest_.get(to) - rest_.get(from)));
+        const auto index = static_cast<std::uint32_t>(surface_.particles + surface_.edge_points.size());
+        surface_.edge_points.push_back(e);
+        surface_.split_place.push_back(place(from, to));
+        made_.emplace(key, index);
+        return index;
+    }
+
+private:
+    ClothSurface& surface_;
+    const DVec3Array& rest_;
+    std::unordered_map<std::uint64_t, std::uint32_t> made_;
+};
+
+// One torn cell, its N corners `k` in the winding of its triangles: each corner's quadrilateral (the corner, its
+// edge points towards the next and the previous corner, its piece's centre) as two triangles. Corners joined by
+// a held spring (`holds`: an edge or, on the grid, a diagonal) form a piece with one centre, placed at `place`;
+// `edge_point(from, to)` gives the points, made already. The centres' vertices start at `first_centre`.
+template <std::size_t N, class Holds, class EdgePoint>
+void split_cell(const std::array<std::uint32_t, N>& k, ClothSurface& surface, std::uint32_t first_centre, glm::vec2 place,
+                Holds&& holds, EdgePoint&& edge_point) {
+    std::array<std::size_t, N> piece{};
+    for (std::size_t i = 0; i < N; ++i) piece[i] = i;
+    auto find = [&](std::size_t i) {
+        while (piece[i] != i) i = piece[i];
+        return i;
+    };
+    for (std::size_t i = 0; i < N; ++i) {
+        for (std::size_t j = i + 1; j < N; ++j) {
+            if (holds(k[i], k[j])) piece[std::max(find(i), find(j))] = std::min(find(i), find(j));
+        }
+    }
+    std::array<std::uint32_t, N> centre_of{};
+    for (std::size_t i = 0; i < N; ++i) {
+        const std::uint32_t next = edge_point(k[i], k[(i + 1) % N]), prev = edge_point(k[i], k[(i + N - 1) % N]);
+        const std::size_t root = find(i);
+        if (root == i) {
+            centre_of[i] = static_cast<std::uint32_t>(surface.centres.size());
+            surface.centres.emplace_back();
+            surface.split_place.push_back(place);
+        } else {
+            centre_of[i] = centre_of[root];
+        }
+        ClothSurface::Centre& centre = surface.centres[centre_of[i]];
+        centre.corner[static_cast<std::size_t>(centre.count++)] = {k[i], next, prev};
+        const std::uint32_t middle = first_centre + centre_of[i];
+        surface.triangles.push_back({k[i], next, middle});
+        surface.triangles.push_back({k[i], middle, prev});
+    }
+}
+
 }  // namespace
 
 ClothCells cells_at_start(const Topology& topology, std::size_t particles) {
@@ -87,23 +154,11 @@ ClothSurface build_mesh_surface(const Topology& topology, const DVec3Array& rest
     }
     auto holds = [&](std::uint32_t a, std::uint32_t b) { return held.count(pair_key(a, b)) != 0; };
     surface.triangles = present;
-    std::unordered_map<std::uint64_t, std::uint32_t> edge_vertex;
+    EdgePoints points(surface, rest);
     auto edge_point = [&](std::uint32_t from, std::uint32_t to) {
-        const bool whole = holds(from, to);
-        const std::uint64_t key = whole ? pair_key(from, to) : ((static_cast<std::uint64_t>(from) << 32) | to);
-        const auto found = edge_vertex.find(key);
-        if (found != edge_vertex.end()) return found->second;
-        ClothSurface::EdgePoint e;
-        e.from = from;
-        e.to = to;
-        e.whole = whole;
-        e.back = ClothSurface::kNoParticle;  // a mesh has no row to continue: a broken edge's end points at the other
-        e.half_rest = static_cast<float>(0.5 * glm::length(rest.get(to) - rest.get(from)));
-        const auto index = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
-        surface.edge_points.push_back(e);
-        surface.split_place.push_back(0.5f * (topology.uv[from] + topology.uv[to]));
-        edge_vertex.emplace(key, index);
-        return index;
+        // A mesh has no row to continue: a broken edge's end points at the other end.
+        return points.get(from, to, holds(from, to), [](std::uint32_t, std::uint32_t) { return ClothSurface::kNoParticle; },
+                          [&](std::uint32_t a, std::uint32_t b) { return 0.5f * (topology.uv[a] + topology.uv[b]); });
     };
     // Every edge point first, then the centres, so that the centres' indices follow all edge points.
     for (const auto& k : torn) {
@@ -114,35 +169,8 @@ ClothSurface build_mesh_surface(const Topology& topology, const DVec3Array& rest
     }
     const auto first_centre = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
     for (const auto& k : torn) {
-        // The triangle's pieces: corners joined by a held edge.
-        std::array<int, 3> piece = {0, 1, 2};
-        auto find = [&](int i) {
-            while (piece[i] != i) i = piece[i];
-            return i;
-        };
-        for (int i = 0; i < 3; ++i) {
-            for (int j = i + 1; j < 3; ++j) {
-                if (holds(k[i], k[j])) piece[std::max(find(i), find(j))] = std::min(find(i), find(j));
-            }
-        }
         const glm::vec2 centroid = (topology.uv[k[0]] + topology.uv[k[1]] + topology.uv[k[2]]) / 3.0f;
-        std::array<std::uint32_t, 3> centre_of{};
-        for (int i = 0; i < 3; ++i) {
-            const std::uint32_t after = edge_point(k[i], k[(i + 1) % 3]), before = edge_point(k[i], k[(i + 2) % 3]);
-            const int root = find(i);
-            if (root == i) {
-                centre_of[i] = static_cast<std::uint32_t>(surface.centres.size());
-                surface.centres.emplace_back();
-                surface.split_place.push_back(centroid);
-            } else {
-                centre_of[i] = centre_of[root];
-            }
-            ClothSurface::Centre& centre = surface.centres[centre_of[i]];
-            centre.corner[static_cast<std::size_t>(centre.count++)] = {k[i], after, before};
-            const std::uint32_t middle = first_centre + centre_of[i];
-            surface.triangles.push_back({k[i], after, middle});
-            surface.triangles.push_back({k[i], middle, before});
-        }
+        split_cell(k, surface, first_centre, centroid, holds, edge_point);
     }
     return surface;
 }
@@ -199,32 +227,18 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
         if (cell < 0 || !torn_cell[static_cast<std::size_t>(cell)]) surface.triangles.push_back(t);
     }
 
-    // Edge points, one per held edge and one per end of a broken edge, each made once.
-    std::unordered_map<std::uint64_t, std::uint32_t> edge_vertex;
+    // Edge points, one per held edge and one per end of a broken edge, each made once. A broken edge's end
+    // continues the particle on the other side of `from`, in line with the edge, when the spring to it holds.
+    EdgePoints points(surface, rest);
     auto place = [&](std::uint32_t v) { return glm::vec2(float(col(v)), float(row(v))); };
+    auto back = [&](std::uint32_t from, std::uint32_t to) {
+        const int rb = 2 * row(from) - row(to), cb = 2 * col(from) - col(to);
+        if (rb >= 0 && rb < rows && cb >= 0 && cb < cols && holds(id(rb, cb), from)) return id(rb, cb);
+        return ClothSurface::kNoParticle;
+    };
     auto edge_point = [&](std::uint32_t from, std::uint32_t to) {
-        const bool whole = holds(from, to);
-        const std::uint64_t key = whole ? pair_key(from, to) : ((static_cast<std::uint64_t>(from) << 32) | to);
-        const auto found = edge_vertex.find(key);
-        if (found != edge_vertex.end()) return found->second;
-        ClothSurface::EdgePoint e;
-        e.from = from;
-        e.to = to;
-        e.whole = whole;
-        e.back = ClothSurface::kNoParticle;
-        e.half_rest = static_cast<float>(0.5 * glm::length(rest.get(to) - rest.get(from)));
-        if (!whole) {
-            // The particle on the other side of `from`, in line with the edge.
-            const int rb = 2 * row(from) - row(to), cb = 2 * col(from) - col(to);
-            if (rb >= 0 && rb < rows && cb >= 0 && cb < cols && holds(id(rb, cb), from)) {
-                e.back = id(rb, cb);
-            }
-        }
-        const auto index = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
-        surface.edge_points.push_back(e);
-        surface.split_place.push_back(0.5f * (place(from) + place(to)));
-        edge_vertex.emplace(key, index);
-        return index;
+        return points.get(from, to, holds(from, to), back,
+                          [&](std::uint32_t a, std::uint32_t b) { return 0.5f * (place(a) + place(b)); });
     };
 
     // Around a cell counter-clockwise (00, 01, 11, 10): corner i's next edge goes to corner i + 1.
@@ -246,34 +260,7 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
     });
     const auto first_centre = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
     for_each_torn_cell([&](int r, int c, const std::array<std::uint32_t, 4>& k) {
-        // The cell's pieces: corners joined by a held edge or diagonal.
-        std::array<int, 4> piece = {0, 1, 2, 3};
-        auto find = [&](int i) {
-            while (piece[i] != i) i = piece[i];
-            return i;
-        };
-        for (int i = 0; i < 4; ++i) {
-            for (int j = i + 1; j < 4; ++j) {
-                if (holds(k[i], k[j])) piece[std::max(find(i), find(j))] = std::min(find(i), find(j));
-            }
-        }
-        std::array<std::uint32_t, 4> centre_of{};
-        for (int i = 0; i < 4; ++i) {
-            const std::uint32_t next = edge_point(k[i], k[(i + 1) % 4]), prev = edge_point(k[i], k[(i + 3) % 4]);
-            const int root = find(i);
-            if (root == i) {
-                centre_of[i] = static_cast<std::uint32_t>(surface.centres.size());
-                surface.centres.emplace_back();
-                surface.split_place.push_back(glm::vec2(float(c) + 0.5f, float(r) + 0.5f));
-            } else {
-                centre_of[i] = centre_of[root];
-            }
-            ClothSurface::Centre& centre = surface.centres[centre_of[i]];
-            centre.corner[centre.count++] = {k[i], next, prev};
-            const std::uint32_t middle = first_centre + centre_of[i];
-            surface.triangles.push_back({k[i], next, middle});
-            surface.triangles.push_back({k[i], middle, prev});
-        }
+        split_cell(k, surface, first_centre, glm::vec2(float(c) + 0.5f, float(r) + 0.5f), holds, edge_point);
     });
     return surface;
 }

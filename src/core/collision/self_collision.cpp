@@ -254,8 +254,7 @@ bool SelfCollision::neighbours(std::uint32_t i, std::uint32_t j) const {
         const int dc = static_cast<int>(j) % cols_ - static_cast<int>(i) % cols_;
         return near_neighbours(i, dr, dc);
     }
-    const auto begin = neighbour_.begin() + neighbour_begin_[i], end = neighbour_.begin() + neighbour_begin_[i + 1];
-    return std::binary_search(begin, end, j);
+    return link_of(i, j) >= 0.0;
 }
 
 bool SelfCollision::fold_pair(std::uint32_t i, std::uint32_t j) const {
@@ -464,8 +463,7 @@ std::size_t SelfCollision::mark_active(const DVec3Array& position, float d, floa
     for (std::uint32_t t = 0; t < tiles; ++t) {
         if (active_[t] == 0) continue;
         ++count;
-        if (active_[t] != 2) continue;
-        if (!grid_) continue;  // listed above, with all its neighbours
+        if (active_[t] != 2) continue;  // (never 2 off the grid: every patch is listed above, with its neighbours)
         const int r = tile_row_[t], c = tile_col_[t];
         for (int dr = -1; dr <= 1; ++dr) {
             for (int dc = -1; dc <= 1; ++dc) {

@@ -79,6 +79,16 @@ private:
     std::unordered_map<std::uint64_t, std::uint32_t> made_;
 };
 
+// Makes the edge points of a torn cell's sides, from each corner to the next and to the previous, before any
+// cell's centre, so that the centres' vertices follow all edge points.
+template <std::size_t N, class EdgePoint>
+void make_edge_points(const std::array<std::uint32_t, N>& k, EdgePoint&& edge_point) {
+    for (std::size_t i = 0; i < N; ++i) {
+        edge_point(k[i], k[(i + 1) % N]);
+        edge_point(k[i], k[(i + N - 1) % N]);
+    }
+}
+
 // One torn cell, its N corners `k` in the winding of its triangles: each corner's quadrilateral (the corner, its
 // edge points towards the next and the previous corner, its piece's centre) as two triangles. Corners joined by
 // a held spring (`holds`: an edge or, on the grid, a diagonal) form a piece with one centre, placed at `place`;
@@ -160,13 +170,7 @@ ClothSurface build_mesh_surface(const Topology& topology, const DVec3Array& rest
         return points.get(from, to, holds(from, to), [](std::uint32_t, std::uint32_t) { return ClothSurface::kNoParticle; },
                           [&](std::uint32_t a, std::uint32_t b) { return 0.5f * (topology.uv[a] + topology.uv[b]); });
     };
-    // Every edge point first, then the centres, so that the centres' indices follow all edge points.
-    for (const auto& k : torn) {
-        for (int i = 0; i < 3; ++i) {
-            edge_point(k[i], k[(i + 1) % 3]);
-            edge_point(k[i], k[(i + 2) % 3]);
-        }
-    }
+    for (const auto& k : torn) make_edge_points(k, edge_point);
     const auto first_centre = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
     for (const auto& k : torn) {
         const glm::vec2 centroid = (topology.uv[k[0]] + topology.uv[k[1]] + topology.uv[k[2]]) / 3.0f;
@@ -252,12 +256,7 @@ ClothSurface build_cloth_surface(const Topology& topology, const DVec3Array& res
             }
         }
     };
-    for_each_torn_cell([&](int, int, const std::array<std::uint32_t, 4>& k) {
-        for (int i = 0; i < 4; ++i) {
-            edge_point(k[i], k[(i + 1) % 4]);
-            edge_point(k[i], k[(i + 3) % 4]);
-        }
-    });
+    for_each_torn_cell([&](int, int, const std::array<std::uint32_t, 4>& k) { make_edge_points(k, edge_point); });
     const auto first_centre = static_cast<std::uint32_t>(surface.particles + surface.edge_points.size());
     for_each_torn_cell([&](int r, int c, const std::array<std::uint32_t, 4>& k) {
         split_cell(k, surface, first_centre, glm::vec2(float(c) + 0.5f, float(r) + 0.5f), holds, edge_point);

@@ -49,10 +49,14 @@ int main(int argc, char** argv) {
                                  "2.5 cm edges; the waist is vertices 0 .. " + waist + " (from 0)."},
             {"cape.obj", "A cloth: a cape, the back 200 degrees of a cone from a 0.30 m ring down 0.85 m to a 0.62 m one, "
                          "2.5 cm edges; the top edge is vertices 0 .. " + collar + " (from 0)."},
+            {"tabard.obj", "A cloth: a tabard, front and back panels 0.40 m wide sewn along the shoulder seam (y = z = 0) "
+                           "either side of an 18 cm square neck, over a 0.14 m yoke; the front 0.75 m and the back 0.70 m "
+                           "long, 2.5 cm edges; rows across from the back hem."},
         };
         const clothsim::TriangleMesh cloth_meshes[] = {cloth_disc(0.15, 25), cloth_disc(0.15, 50),
                                                        cloth_annulus(0.275, 0.105, 0.45, 0.025),
-                                                       cloth_cone_back(0.30, 0.62, 0.85, 0.025, 200.0)};
+                                                       cloth_cone_back(0.30, 0.62, 0.85, 0.025, 200.0),
+                                                       clothsim::cloth_tabard(clothsim::TabardPattern{})};
         for (std::size_t k = 0; k < std::size(cloth_meshes); ++k) {
             const std::filesystem::path path = dir / cloth[k][0];
             clothsim::write_mesh_file(cloth_meshes[k], path,

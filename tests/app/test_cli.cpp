@@ -807,7 +807,7 @@ TEST_CASE("cli: --list-scenes prints the bundled scenes") {
     CHECK(lines_of(r.out) ==
           std::vector<std::string>{"cape", "chair-drape", "curtain", "cusick", "drape-cube", "drape-sphere", "falling",
                                    "flag", "fold", "hanging", "mannequin-drape", "moving-ball", "pile", "skirt",
-                                   "stiff-drape", "stiff-hanging", "tablecloth", "tear"});
+                                   "stiff-drape", "stiff-hanging", "tabard", "tablecloth", "tear"});
 }
 
 TEST_CASE("cli: --list-fields lists every scene field") {

@@ -4,6 +4,7 @@
 #include "clothsim/mesh_file.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/stability.hpp"
+#include "clothsim/strain.hpp"
 #include "model/forces.hpp"
 #include "support.hpp"
 #include "temp_dir.hpp"
@@ -593,4 +594,57 @@ TEST_CASE("cloth mesh: a live change of the fabric puts the new stretch, bending
     Scene per_spring = edited;
     per_spring.material.enabled = false;
     CHECK_THROWS_WITH(apply_fabric(sim, per_spring), Catch::Contains("rebuild the cloth"));
+}
+
+TEST_CASE("cloth mesh: the tabard, dropped unpinned, comes to rest on the mannequin's shoulders with a panel on "
+          "either side",
+          "[cloth_mesh][settled]") {
+    // The mannequin's shoulders are a capsule of radius 0.065 m about y = 1.42 (mesh_shapes.cpp), so its top is
+    // 1.485 m; the collision shell is 8 mm. The seam starts 12 mm above the shoulders, with nothing holding it.
+    const Scene scene = load_scene("tabard");
+    MassSpring sim = build_simulation(scene);
+    std::vector<std::size_t> seam, front_hem, back_hem;
+    double lowest = 1e9, highest = -1e9;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::dvec3 p = sim.state().position.get(i);
+        lowest = std::min(lowest, p.y);
+        highest = std::max(highest, p.y);
+    }
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::dvec3 p = sim.state().position.get(i);
+        if (p.y == highest) seam.push_back(i);
+        if (p.y < lowest + 1e-9) (p.z > 0.0 ? front_hem : back_hem).push_back(i);
+    }
+    REQUIRE(seam.size() == 10);
+    REQUIRE(front_hem.size() == 16);
+    REQUIRE(back_hem.empty());  // the back is 5 cm shorter
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        const glm::dvec3 p = sim.state().position.get(i);
+        if (p.z < 0.0 && p.y < highest - 0.14 - 0.70 + 0.14 * std::numbers::pi / 2.0 + 1e-9) back_hem.push_back(i);
+    }
+    REQUIRE(back_hem.size() == 16);
+    sim.run_steps(180);
+    REQUIRE(sim.all_finite());
+    const double kinetic = sim.energy().kinetic;
+    INFO("kinetic energy after 3 s " << kinetic << " J");
+    CHECK(kinetic < 1e-3);
+    for (std::size_t i : seam) {
+        INFO("seam vertex " << i << " at " << sim.position(i).y << " m");
+        CHECK(sim.position(i).y > 1.485 + 0.004);
+        CHECK(sim.position(i).y < 1.485 + 0.012);
+    }
+    double front = 0.0, back = 0.0, front_y = 0.0;
+    for (std::size_t i : front_hem) front += sim.position(i).z / front_hem.size(), front_y += sim.position(i).y / front_hem.size();
+    for (std::size_t i : back_hem) back += sim.position(i).z / back_hem.size();
+    INFO("front hem at z " << front << " m, y " << front_y << " m; back hem at z " << back << " m");
+    CHECK(front > 0.10);
+    CHECK(back < -0.10);
+    // It hangs: the front hem lies most of the front's 0.75 m below the seam (the cloth over the shoulder and the
+    // chest is not vertical), and no farther than the cloth's length and its largest strain allow.
+    const double seam_y = sim.position(seam[0]).y;
+    CHECK(seam_y - front_y > 0.9 * 0.75);
+    CHECK(seam_y - front_y < 1.02 * 0.75);
+    const double strain = max_strain(sim.topology(), sim.state().position, SpringKind::Structural);
+    INFO("largest strain " << strain);
+    CHECK(strain < 0.03);
 }

@@ -7,7 +7,10 @@
 #include <glm/geometric.hpp>
 
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <set>
+#include <vector>
 
 using namespace clothsim;
 
@@ -62,4 +65,66 @@ TEST_CASE("cloth mesh shapes: the circle skirt's and the cape's first rows are t
     // A cone's lateral area over 200 degrees: (200 / 360) pi (r1 + r2) slant, less the chords' (under 1%).
     const double lateral = 200.0 / 360.0 * std::numbers::pi * (0.30 + 0.62) * std::hypot(0.32, 0.85);
     CHECK(area(cape) == Approx(lateral).epsilon(0.01));
+}
+
+TEST_CASE("cloth mesh shapes: the tabard is two panels sewn at the shoulder seam, a cloth with a square neck and "
+          "its pattern's area",
+          "[cloth_mesh]") {
+    const TabardPattern p;
+    const TriangleMesh tabard = cloth_tabard(p);
+    CHECK(cloth_mesh_problem(tabard.vertices(), tabard.triangles()).empty());
+    // Every vertex lies on the pattern's surface: on the yoke's half cylinder, or on a panel's plane.
+    const double r = p.yoke_radius;
+    int seam = 0;
+    for (const glm::dvec3& v : tabard.vertices()) {
+        CHECK(std::abs(v.x) <= 0.5 * p.width + 1e-12);
+        if (v.y >= -r) {
+            CHECK(std::hypot(v.y + r, v.z) == Approx(r).epsilon(1e-12));
+        } else {
+            CHECK(std::abs(v.z) == r);
+        }
+        // The shoulder seam, on the straps only: the neck is open there.
+        if (v.y == 0.0 && v.z == 0.0) {
+            ++seam;
+            CHECK(std::abs(v.x) >= p.neck_half_width - 1e-12);
+        }
+    }
+    CHECK(seam == 10);  // 5 points across each strap
+    // Two boundary loops, the outline (2 x 0.40 + 2 x 1.45 m) and the neck (2 x 0.18 + 2 x 0.15 m): edges used by
+    // one triangle, their lengths the pattern's less what the yoke's chords cut off (under 0.2%).
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (const auto& t : tabard.triangles()) {
+        for (int e = 0; e < 3; ++e) {
+            const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+            ++uses[{std::min(a, b), std::max(a, b)}];
+        }
+    }
+    double boundary = 0.0;
+    std::map<std::uint32_t, std::vector<std::uint32_t>> next;
+    for (const auto& [edge, count] : uses) {
+        if (count != 1) continue;
+        boundary += glm::length(tabard.vertices()[edge.first] - tabard.vertices()[edge.second]);
+        next[edge.first].push_back(edge.second);
+        next[edge.second].push_back(edge.first);
+    }
+    int loops = 0;
+    std::set<std::uint32_t> seen;
+    for (const auto& [start, _] : next) {
+        if (seen.count(start)) continue;
+        ++loops;
+        for (std::uint32_t at = start, from = start; !seen.count(at);) {
+            seen.insert(at);
+            REQUIRE(next[at].size() == 2);
+            const std::uint32_t to = next[at][0] == from ? next[at][1] : next[at][0];
+            from = at;
+            at = to;
+        }
+    }
+    CHECK(loops == 2);
+    const double outline = 2.0 * (p.width + p.front_length + p.back_length);
+    const double neck = 2.0 * (2.0 * p.neck_half_width + p.neck_front + p.neck_back);
+    CHECK(boundary == Approx(outline + neck).epsilon(0.002));
+    CHECK(boundary < outline + neck);
+    const double pattern = p.width * (p.front_length + p.back_length) - 2.0 * p.neck_half_width * (p.neck_front + p.neck_back);
+    CHECK(area(tabard) == Approx(pattern).epsilon(0.002));
 }

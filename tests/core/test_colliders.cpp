@@ -778,9 +778,9 @@ TEST_CASE("colliders the sphere's four-lane block test moves every particle as t
 TEST_CASE("colliders the bundled mesh drapes hold: settled for 3 s, no particle is inside a mesh and none closer "
           "than half the thickness",
           "[settled]") {
-    // tablecloth (the round table), mannequin-drape and chair-drape at their own size: the generalised winding
+    // tablecloth (the round table), mannequin-drape, chair-drape and tabard at their own size: the generalised winding
     // number (TriangleMesh::winding_number) says inside, the tree the distance.
-    for (const char* name : {"tablecloth", "mannequin-drape", "chair-drape"}) {
+    for (const char* name : {"tablecloth", "mannequin-drape", "chair-drape", "tabard"}) {
         INFO("scene " << name);
         const Scene scene = load_scene(name);
         MassSpring sim = build_simulation(scene);

@@ -58,5 +58,5 @@ TEST_CASE("asset tools: clothsim-make-meshes writes the bundled meshes byte for 
         CHECK(read_file(made) == read_file(entry.path()));
         ++files;
     }
-    CHECK(files == 7);
+    CHECK(files == 8);
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <numbers>
 #include <vector>
 
@@ -30,6 +32,13 @@ void zip_rows(std::vector<std::uint32_t> a, std::vector<std::uint32_t> b, bool c
             ++j;
         }
     }
+}
+
+// a, then points about `edge` apart on to b (b included), at least one step.
+void add_stations(std::vector<double>& out, double a, double b, double edge) {
+    const int steps = std::max(1, static_cast<int>(std::lround((b - a) / edge)));
+    if (out.empty()) out.push_back(a);
+    for (int k = 1; k <= steps; ++k) out.push_back(k == steps ? b : a + (b - a) * k / steps);
 }
 
 double ellipse_perimeter(double a, double b) {  // Ramanujan's approximation
@@ -105,6 +114,56 @@ TriangleMesh cloth_cone_back(double top_radius, double bottom_radius, double hei
     }
     Triangles triangles;
     for (int k = 0; k < count_rows; ++k) zip_rows(rows[k], rows[k + 1], false, triangles);
+    return TriangleMesh(std::move(vertices), std::move(triangles));
+}
+
+glm::dvec3 tabard_point(const TabardPattern& p, double x, double s) {
+    const double r = p.yoke_radius, quarter = 0.5 * std::numbers::pi * r;
+    if (std::abs(s) <= quarter) return {x, r * (std::cos(s / r) - 1.0), r * std::sin(s / r)};
+    return {x, -r - (std::abs(s) - quarter), s > 0.0 ? r : -r};
+}
+
+TriangleMesh cloth_tabard(const TabardPattern& p) {
+    // Stations across and along, so that the neck's sides and edges and the shoulder seam are rows and columns.
+    std::vector<double> across, along;
+    add_stations(across, -0.5 * p.width, -p.neck_half_width, p.edge);
+    const std::size_t neck_left = across.size() - 1;
+    add_stations(across, -p.neck_half_width, p.neck_half_width, p.edge);
+    const std::size_t neck_right = across.size() - 1;
+    add_stations(across, p.neck_half_width, 0.5 * p.width, p.edge);
+    add_stations(along, -p.back_length, -p.neck_back, p.edge);
+    const std::size_t neck_first = along.size() - 1;
+    add_stations(along, -p.neck_back, 0.0, p.edge);
+    add_stations(along, 0.0, p.neck_front, p.edge);
+    const std::size_t neck_last = along.size() - 1;
+    add_stations(along, p.neck_front, p.front_length, p.edge);
+
+    // A row strictly inside the neck holds only the points either side of it.
+    const auto in_neck = [&](std::size_t row, std::size_t column) {
+        return row > neck_first && row < neck_last && column > neck_left && column < neck_right;
+    };
+    std::vector<glm::dvec3> vertices;
+    std::vector<std::vector<std::uint32_t>> index(along.size(), std::vector<std::uint32_t>(across.size(), 0));
+    for (std::size_t k = 0; k < along.size(); ++k) {
+        for (std::size_t c = 0; c < across.size(); ++c) {
+            if (in_neck(k, c)) continue;
+            index[k][c] = static_cast<std::uint32_t>(vertices.size());
+            vertices.push_back(tabard_point(p, across[c], along[k]));
+        }
+    }
+    const auto part = [&](std::size_t row, std::size_t first, std::size_t last) {
+        return std::vector<std::uint32_t>(index[row].begin() + static_cast<std::ptrdiff_t>(first),
+                                          index[row].begin() + static_cast<std::ptrdiff_t>(last) + 1);
+    };
+    Triangles triangles;
+    for (std::size_t k = 0; k + 1 < along.size(); ++k) {
+        if (k + 1 <= neck_first || k >= neck_last) {
+            zip_rows(index[k], index[k + 1], false, triangles);
+        } else {  // the two shoulder straps either side of the neck
+            zip_rows(part(k, 0, neck_left), part(k + 1, 0, neck_left), false, triangles);
+            zip_rows(part(k, neck_right, across.size() - 1), part(k + 1, neck_right, across.size() - 1), false, triangles);
+        }
+    }
     return TriangleMesh(std::move(vertices), std::move(triangles));
 }
 

@@ -158,6 +158,9 @@ public:
     double calm_seconds() const;
     // Wakes a sleeping cloth (from rest) and restarts the count towards sleep.
     void wake();
+    // Stops every particle where it is: zero velocity, positions unchanged (a settle's kinetic damping,
+    // settle.hpp). A multistep integrator starts afresh.
+    void stop();
     // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
     // positions, even across copies (a rollback), so a renderer can skip normals and uploads.
     std::uint64_t change_stamp() const { return stamp_; }

@@ -83,6 +83,7 @@ void record_energy(AppState& app) {
 
 // What a new cloth resets: the grab, the time owed, the plots, the renderer's buffers.
 void after_rebuild(AppState& app, Renderer& renderer) {
+    app.settling.reset();
     app.grab.reset();
     app.object_drag.reset();
     app.stepper.restart();
@@ -147,8 +148,43 @@ void record_plots(AppState& app, bool rested) {
     }
 }
 
-// This frame's physics, through the stepper: one step per frame in scripted runs and while recording, one
-// for Step, otherwise
+// Settle's share of a frame: steps with kinetic damping until the cloth settles or kSettleFrameSeconds of wall
+// time pass (a settle runs as fast as the machine allows, not in real time; the window stays responsive), and
+// in scripted runs and while recording one step a frame. Says how it ended.
+constexpr double kSettleFrameSeconds = 0.05;
+StepReport settle_frame(AppState& app, bool one_step_a_frame) {
+    const auto start = Clock::now();
+    StepReport total;
+    for (;;) {
+        StepReport r = app.stepper.run(app.sim, 1);
+        total.steps += r.steps;
+        total.guard_log += r.guard_log;
+        total.skipped_non_finite = r.skipped_non_finite;
+        total.guard_gave_up = r.guard_gave_up;
+        if (r.steps == 0 || r.guard_gave_up || r.skipped_non_finite) {
+            app.say("settle stopped: the cloth did not step", true);
+            app.settling.reset();
+            break;
+        }
+        if (app.settling->after_step(app.sim)) {
+            char text[160];
+            std::snprintf(text, sizeof text, "settled at t = %.2f s: residual %.3g (tolerance %.3g), %d velocity resets",
+                          app.sim.time(), app.settling->residual().value, app.settling->options().tolerance,
+                          app.settling->resets());
+            app.say(text);
+            std::printf("clothsim: %s\n", text);  // and on the terminal, as a finished long job
+            std::fflush(stdout);
+            app.settling.reset();
+            break;
+        }
+        if (one_step_a_frame || std::chrono::duration<double>(Clock::now() - start).count() >= kSettleFrameSeconds) break;
+    }
+    app.stepper.restart();  // no real time is owed for what the settle ran
+    return total;
+}
+
+// This frame's physics, through the stepper: Settle's steps while it runs, one step per frame in scripted runs
+// and while recording, one for Step, otherwise
 // the wall time that passed (scaled) in fixed steps of integration.dt. Returns true when the scene must
 // restart (the guard failed twice in a row).
 bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
@@ -156,7 +192,9 @@ bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
     app.sim.reset_profile();
     const bool was_resting = app.sim.asleep();
     StepReport report;
-    if (app.step_once) {
+    if (app.settling) {
+        report = settle_frame(app, one_step_a_frame);
+    } else if (app.step_once) {
         report = app.stepper.run(app.sim, 1);
     } else if (app.paused) {
         report = app.stepper.run(app.sim, 0);  // auto substeps still follows the panel's edits
@@ -172,7 +210,7 @@ bool simulate(AppState& app, double wall_seconds, bool one_step_a_frame) {
                 true);
     }
     if (report.steps > 0) record_plots(app, was_resting && app.sim.asleep());
-    if (!app.paused && !one_step_a_frame) {  // playing in real time: is it keeping up?
+    if (!app.paused && !one_step_a_frame && !app.settling) {  // playing in real time: is it keeping up?
         app.stats.window_wall += wall_seconds;
         app.stats.window_simulated += double(report.steps) * app.sim.settings().integration.dt;
         if (app.stats.window_wall >= 0.5) {

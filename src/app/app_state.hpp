@@ -15,6 +15,7 @@
 
 #include <glm/vec2.hpp>
 #include "clothsim/scene.hpp"
+#include "clothsim/settle.hpp"
 #include "clothsim/stability.hpp"
 #include "clothsim/stepper.hpp"
 
@@ -163,6 +164,9 @@ struct AppState {
     ViewSettings view;
     bool paused = false;
     bool step_once = false;
+    // Settle (the panel): while set, each frame runs the dynamics with kinetic damping (settle.hpp) as fast as
+    // the frame allows, until the cloth is settled; a new cloth (reset, load, an edit that rebuilds) ends it.
+    std::optional<Settler> settling;
     float time_scale = 1.0f;   // simulated seconds per wall second
     bool show_panel = true;
     float panel_width = kPanelWidth;  // window coordinates at content scale 1; the user drags the panel's edge

@@ -9,6 +9,8 @@ inline constexpr int kExitBadInput = 2;    // a bad flag, scene or output path; 
 inline constexpr int kExitBlowUp = 3;      // the simulation blew up: a step failed the guard's check (non-finite
                                            // positions, strain or an energy jump beyond GuardSettings in
                                            // clothsim/stability.hpp), or --guard ran out of retries
-inline constexpr int kExitGlError = 4;     // an OpenGL error in a scripted (--frames) run
+inline constexpr int kExitGlError = 4;
+inline constexpr int kExitNotSettled = 5;  // --settle ran its whole time (--duration, --steps or 30 s) without the
+                                           // residual falling below the tolerance     // an OpenGL error in a scripted (--frames) run
 
 }  // namespace clothsim

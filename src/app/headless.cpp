@@ -3,6 +3,7 @@
 #include "clothsim/export.hpp"
 #include "clothsim/intersections.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/settle.hpp"
 #include "clothsim/stability.hpp"
 #include "clothsim/step_plan.hpp"
 #include "clothsim/stepper.hpp"
@@ -18,11 +19,14 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace clothsim {
 namespace {
+
+constexpr double kSettleSeconds = 30.0;  // a settle's time limit when --duration and --steps are not given
 
 bool parent_exists(const std::string& path) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
@@ -126,7 +130,7 @@ struct RunOutcome {
 // would roll back stops the run there, finite or not: a blow-up held finite by tethers (1e9 J and more) is
 // still a blow-up. With --guard the guard itself checks and retries.
 RunOutcome simulate(MassSpring& sim, Stepper& stepper, long long steps, const HeadlessOptions& options,
-                    TrajectoryWriter* trajectory) {
+                    TrajectoryWriter* trajectory, Settler* settler) {
     RunOutcome run;
     const auto start = std::chrono::steady_clock::now();
     const GuardSettings& guard = stepper.policy().guard_settings;
@@ -147,9 +151,11 @@ RunOutcome simulate(MassSpring& sim, Stepper& stepper, long long steps, const He
         } else if (!run.finite) {
             run.blow_up = BlowUp::NonFinite;
         }
-        if (trajectory && (run.steps % options.every == 0 || run.steps == steps || run.blew_up())) {
+        const bool settled = settler && !run.blew_up() && settler->after_step(sim);
+        if (trajectory && (run.steps % options.every == 0 || run.steps == steps || run.blew_up() || settled)) {
             trajectory->record(run.steps, sim);
         }
+        if (settled) break;
     }
     run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return run;
@@ -241,7 +247,8 @@ nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 
 // One JSON object: the scene, what ran (the substeps in force at the end: auto substeps' choice or the
 // guard's), energies, the largest membrane strain and the step profile.
-void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit) {
+void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const StabilityLimit& limit,
+                const Settler* settler) {
     const Energy e = sim.energy();
     const std::vector<StageStatus> stages = describe(sim.plan(), sim.topology(), sim.settings());
     nlohmann::json out = {
@@ -284,6 +291,15 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         solver["residual"] = finite_or_null(sim.last_solver_residual());
     }
     out["solver"] = solver;
+    if (settler) {
+        out["settle"] = {
+            {"settled", settler->settled()},
+            {"residual", finite_or_null(settler->residual().value)},
+            {"particle", settler->residual().particle},
+            {"tolerance", settler->options().tolerance},
+            {"velocity_resets", settler->resets()},
+        };
+    }
     // A disc (a grid's, or a mesh cloth) on the cylinder is a Cusick drape test (drape.hpp): its coefficient and
     // folds.
     const CylinderCollider* support = nullptr;
@@ -299,7 +315,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     std::cout << out.dump(2) << std::endl;
 }
 
-void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run) {
+void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run, const Settler* settler) {
     const Energy e = sim.energy();
     std::printf("scene %s: %zu particles, %zu springs\n", scene.name.c_str(), sim.particle_count(), sim.spring_count());
     std::printf("ran %lld steps of %.6g s (%d substeps each): %.4g simulated s in %.3f wall s\n", run.steps,
@@ -307,6 +323,11 @@ void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run
     std::printf("energy: kinetic %.6g J, potential %.6g J, total %.6g J; finite: %s; blew up: %s%s%s\n", e.kinetic,
                 e.potential(), e.total(), run.finite ? "yes" : "no", run.blew_up() ? "yes (" : "no",
                 run.cause(), run.blew_up() ? ")" : "");
+    if (settler) {
+        std::printf("%s after %.4g simulated s: residual %.3g (tolerance %.3g) at particle %zu, %d velocity resets\n",
+                    settler->settled() ? "settled" : "not settled", sim.time(), settler->residual().value,
+                    settler->options().tolerance, settler->residual().particle, settler->resets());
+    }
     print_profile(sim.profile(), describe(sim.plan(), sim.topology(), sim.settings()), run.steps, sim.asleep());
 }
 
@@ -334,18 +355,27 @@ int run_headless(const Scene& scene, const HeadlessOptions& options) {
         std::cerr << "clothsim: warning: " << substep.text << " (" << substep.fix << " needed); expect a blow-up"
                   << (policy.guard ? ", which --guard will retry with more substeps" : "") << "\n";
     }
+    // A settle runs until it settles, up to 30 simulated s unless told.
     const long long steps = options.steps ? *options.steps
                             : options.duration ? std::llround(*options.duration / dt)
-                                               : std::llround(1.0 / dt);
+                                               : std::llround((options.settle ? kSettleSeconds : 1.0) / dt);
+    std::optional<Settler> settler;
+    if (options.settle) settler.emplace(SettleOptions{.tolerance = options.settle_tolerance});
     std::unique_ptr<TrajectoryWriter> trajectory;
     if (const std::string error = open_outputs(options, sim, trajectory); !error.empty()) {
         std::cerr << "clothsim: error: " << error << "\n";
         return kExitBadInput;
     }
-    const RunOutcome run = simulate(sim, stepper, steps, options, trajectory.get());
-    const int code = finish(options, sim, run, limit, trajectory.get());
-    if (options.json) print_json(scene, sim, run, limit);
-    else print_text(scene, sim, run);
+    const RunOutcome run = simulate(sim, stepper, steps, options, trajectory.get(), settler ? &*settler : nullptr);
+    int code = finish(options, sim, run, limit, trajectory.get());
+    if (settler && !settler->settled() && code == kExitOk) {
+        std::fprintf(stderr, "clothsim: not settled after %.4g simulated s: residual %.3g at particle %zu, tolerance %.3g "
+                             "(a longer --duration, or a larger --settle-tolerance)\n",
+                     sim.time(), settler->residual().value, settler->residual().particle, settler->options().tolerance);
+        code = kExitNotSettled;
+    }
+    if (options.json) print_json(scene, sim, run, limit, settler ? &*settler : nullptr);
+    else print_text(scene, sim, run, settler ? &*settler : nullptr);
     return code;
 }
 

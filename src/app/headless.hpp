@@ -20,6 +20,8 @@ struct HeadlessOptions {
     bool json = false;
     float auto_substeps = 0.0f;      // > 0: pick integration.substeps so the substep is this fraction of dt_crit
     bool guard = false;              // roll back and double the substeps when a step blows up
+    bool settle = false;             // settle to rest (settle.hpp) instead of running a set time
+    double settle_tolerance = 0.01;  // with settle: the residual that counts as settled
 };
 
 int run_headless(const Scene& scene, const HeadlessOptions& options);

@@ -121,6 +121,14 @@ void add_flags(CLI::App& app, CommandLine& cl) {
                    "Choose integration.substeps so the substep is this fraction of the critical one (the app "
                    "does this by default at 0.5, except in --frames runs)")
         ->transform(number_check({.min = 0.01, .max = 1, .meaning = "x the critical substep"}));
+    auto* settle = app.add_flag("--settle", cl.options.settle,
+                                "Headless: settle the cloth to rest (kinetic damping) until its residual, the largest net "
+                                "force on a particle over its weight, falls below --settle-tolerance; --duration or "
+                                "--steps limit it (default 30 s); exit 5 if it does not settle")
+                       ->needs(headless_flag);
+    app.add_option("--settle-tolerance", cl.options.settle_tolerance, "With --settle: the residual that counts as settled (default 0.01)")
+        ->transform(number_check({.min_excluded = true, .max = 1, .meaning = "x a particle's weight"}))
+        ->needs(settle);
     app.add_flag("--guard", cl.options.guard,
                  "Headless: when a step blows up, roll back, double integration.substeps and retry (says so)");
     app.add_flag("--list-scenes", cl.list_scenes, "List the bundled scenes and exit");

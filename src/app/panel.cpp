@@ -621,6 +621,25 @@ void scene_section(AppState& app, PanelRequests& requests) {
     ImGui::SameLine();
     if (ImGui::Button("Revert")) requests.revert = true;
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the scene as loaded or last saved, dropping every edit");
+    ImGui::SameLine();
+    if (ImGui::Button(app.settling ? "Stop settling" : "Settle")) {
+        if (app.settling) app.settling.reset();
+        else app.settling.emplace();
+    }
+    if (ImGui::IsItemHovered()) {
+        ImGui::SetTooltip("runs the cloth to rest as fast as it can: the dynamics with every velocity zeroed past each "
+                          "peak of the kinetic energy (kinetic damping), until the largest net force on a particle is "
+                          "under 1%% of its weight (docs/MATERIAL.md)");
+    }
+    if (app.settling) {
+        const Residual& r = app.settling->residual();
+        if (std::isfinite(r.value)) {
+            ImGui::Text("settling: residual %.3g (to %.3g), %d resets, t = %.2f s", r.value, app.settling->options().tolerance,
+                        app.settling->resets(), app.sim.time());
+        } else {
+            ImGui::Text("settling: t = %.2f s", app.sim.time());
+        }
+    }
     ImGui::SliderFloat("time scale", &app.time_scale, 0.05f, 4.0f, "%.2fx",
                        ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("simulated seconds per wall-clock second");

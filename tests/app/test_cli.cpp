@@ -897,3 +897,43 @@ TEST_CASE("cli: a scene of two spheres, two boxes and a cylinder runs headless, 
     }
     CHECK(found == 1);
 }
+
+TEST_CASE("cli: --settle runs until the residual falls below the tolerance and reports it, and short of that exits 5 "
+          "saying so") {
+    const std::vector<std::string> small = {"--headless", "--scene", "hanging", "--set", "cloth.rows=16", "--set", "cloth.cols=16", "--settle"};
+    std::vector<std::string> json = small;
+    json.push_back("--json");
+    const RunResult settled = run_clothsim(json);
+    CAPTURE_RUN(settled);
+    REQUIRE(settled.code == 0);
+    const nlohmann::json out = nlohmann::json::parse(settled.out);
+    const nlohmann::json settle = out.at("settle");
+    CHECK(settle.at("settled") == true);
+    CHECK(settle.at("residual").get<double>() < 0.01);
+    CHECK(settle.at("tolerance").get<double>() == 0.01);
+    CHECK(settle.at("velocity_resets").get<int>() > 0);
+    // It stops once settled, before the 30 s limit.
+    CHECK(out.at("simulated_seconds").get<double>() < 29.0);
+    // A looser tolerance settles sooner.
+    std::vector<std::string> loose = json;
+    loose.insert(loose.end(), {"--settle-tolerance", "0.1"});
+    const RunResult sooner = run_clothsim(loose);
+    CAPTURE_RUN(sooner);
+    REQUIRE(sooner.code == 0);
+    CHECK(nlohmann::json::parse(sooner.out).at("simulated_seconds").get<double>() < out.at("simulated_seconds").get<double>());
+    // Cut short by --duration: exit 5, the residual named.
+    std::vector<std::string> short_run = small;
+    short_run.insert(short_run.end(), {"--duration", "0.5"});
+    const RunResult unsettled = run_clothsim(short_run);
+    CAPTURE_RUN(unsettled);
+    CHECK(unsettled.code == 5);
+    CHECK_THAT(unsettled.err, Contains("not settled after 0.5 simulated s: residual"));
+    CHECK_THAT(unsettled.out, Contains("not settled after 0.5 simulated s"));
+    // Flags that need one another, and a tolerance out of range.
+    const RunResult windowed = run_clothsim({"--scene", "hanging", "--settle"});
+    CHECK(windowed.code == 2);
+    CHECK_THAT(windowed.err, Contains("--settle requires --headless"));
+    const RunResult zero = run_clothsim({"--headless", "--scene", "hanging", "--settle", "--settle-tolerance", "0"});
+    CHECK(zero.code == 2);
+    CHECK_THAT(zero.err, Contains("--settle-tolerance: 0 is out of range"));
+}

@@ -570,6 +570,11 @@ void MassSpring::wake() {
     if (in_->sleep.wake()) restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
 }
 
+void MassSpring::stop() {
+    wake();
+    restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
+}
+
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
 // moving in proportion to their inverse masses (one Gauss-Seidel pass, spring-list order). The correction
 // adds no velocity of its own (like a collision push), and the ends' motion apart along the spring is

@@ -264,7 +264,7 @@ private:
     // Sizes the collision blocks' boxes for the grid and records the bounds box_rows makes them with.
     void start_boxes(BlockBounds bounds);
     // Boxes rows [begin, end) of the collision blocks (the fast solver's grid layout).
-    void box_rows(int begin, int end, BlockBounds bounds);
+    void box_rows(int band, int begin, int end, BlockBounds bounds);
     // Each returns whether it moved a particle.
     bool limit_strain();
     bool limit_speed(double h);

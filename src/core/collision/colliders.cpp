@@ -387,7 +387,10 @@ bool collide_stage(State& state, const ColliderSettings& colliders, bool broad_p
                 box_range(0, count);
             }
         }
-        blocks.cloth = union_of(blocks.boxes.data(), count);
+        // Boxes as the bands made them, with nothing added: the union of the bands' unions is theirs.
+        const bool unions = from_sweep && reach == glm::vec3(0.0f) && blocks.band_unions;
+        blocks.cloth = unions ? union_of(blocks.band_union.data(), blocks.band_union.size()) : union_of(blocks.boxes.data(), count);
+        blocks.band_unions = false;
         blocks.boxes_current = blocks.current = true;
     }
     const float thickness = colliders.thickness;

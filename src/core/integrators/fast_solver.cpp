@@ -458,7 +458,8 @@ int FastSolver::band_count(int threads) const {
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
-                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds) {
+                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds,
+                      Box* band_unions) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
     const int threads = effective_threads(settings.solver.threads);
     const int bands = band_count(threads);
@@ -486,6 +487,10 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     const bool automatic = settings.solver.threads == 0 && threads > 1;
     const bool single = threads == 1 || (automatic && team_.next_is_single());
     if (motion_bounds) *motion_bounds = MotionBounds{};
+    const auto give_unions = [&](int used) {
+        if (!band_unions || !row_boxes) return;
+        for (int b = 0; b < kMaxBands; ++b) band_unions[b] = b < used ? scratch_[b].box_union : Box{};
+    };
     if (single) {
         const auto start = std::chrono::steady_clock::now();
         sweep(state, sweep_settings, 0, rows_, scratch_[0], no_boundary_);
@@ -494,6 +499,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         state.substep = h;
         last_bands_ = 1;
         last_threads_ = 1;
+        give_unions(1);
         return;
     }
     const auto start = std::chrono::steady_clock::now();
@@ -514,6 +520,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
     if (automatic) team_.record(false, std::chrono::steady_clock::now() - start);
     last_bands_ = bands;
     last_threads_ = threads;
+    give_unions(bands);
     for (int b = 0; motion_bounds && b < bands; ++b) {
         if (band_begin(b, bands) < band_begin(b + 1, bands)) {
             motion_bounds->include(reduce_lanes(scratch_[b].motion_lanes.data()));
@@ -892,6 +899,11 @@ void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int 
                         sweep.row_boxes, sweep.bounds, scratch.window.data(), zeros_.data(),
                         sweep.motion_bounds ? scratch.motion_lanes.data() : nullptr};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);
+    if (sweep.row_boxes) {  // while this band's boxes are in this core's cache
+        const std::size_t per_row = blocks_per_row(cols_);
+        scratch.box_union = union_of(sweep.row_boxes + static_cast<std::size_t>(begin) * per_row,
+                                     static_cast<std::size_t>(end - begin) * per_row);
+    }
 }
 
 }  // namespace clothsim

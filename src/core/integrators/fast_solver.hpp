@@ -51,10 +51,12 @@ public:
     // caller's next stage; for it, `row_boxes` (when not null) receives the box of every block of
     // block_starts(rows x cols) after the update (only its lowest point with BlockBounds::Lowest), and
     // `motion_bounds` (when not null) the bounds of every particle's new motion, each row's taken in its
-    // update (for self-collision, self_collision.hpp, and the colliders' swept boxes, colliders.hpp).
+    // update (for self-collision, self_collision.hpp, and the colliders' swept boxes, colliders.hpp). With
+    // `row_boxes`, `band_unions` (when not null, kMaxBands entries) receives the union of each band's boxes,
+    // made on the band's thread, the rest empty: the cloth's box without reading every block's box again.
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
               double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
-              BlockBounds bounds = BlockBounds::Box);
+              BlockBounds bounds = BlockBounds::Box, Box* band_unions = nullptr);
 
     // Threads the solver will really use for `requested` (0 = one per core): at most one per 8 rows.
     int effective_threads(int requested) const;
@@ -85,6 +87,7 @@ private:
         // The running bounds of the motion of the rows this band's sweep updated, when asked for: 8 lanes of
         // lo and of hi per component (fast_solver.cpp).
         alignas(64) std::array<double, 48> motion_lanes{};
+        Box box_union;  // the union of the boxes this band's sweep made, when it made them
     };
     struct SweepSettings {
         const SimulationSettings& settings;

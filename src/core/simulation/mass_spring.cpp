@@ -373,10 +373,13 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     if (boxes) in_->blocks.bounds = block_bounds_for(colliders_now(), in_->blocks);
     {
         StageTimer timer(profile, Stage::Fast);
+        static_assert(CollisionBlocks::kBandUnions == FastSolver::kMaxBands);
         in_->fast->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &in_->blocks.boxes : nullptr,
-                           sweep_takes_motion_bounds() ? &in_->motion_bounds : nullptr, in_->blocks.bounds);
+                        sweep_takes_motion_bounds() ? &in_->motion_bounds : nullptr, in_->blocks.bounds,
+                        boxes ? in_->blocks.band_union.data() : nullptr);
     }
     in_->blocks.boxes_current = boxes;
+    in_->blocks.band_unions = boxes;
     in_->blocks.current = false;  // the cloth's box is the union, made by the collision stage
 }
 
@@ -439,7 +442,7 @@ std::size_t MassSpring::apply_tethers(const BlockBounds* boxes) {
         const std::size_t first = first_tether_from(in_->tethers, static_cast<std::uint32_t>(begin) * cols);
         const std::size_t last = first_tether_from(in_->tethers, static_cast<std::uint32_t>(end) * cols);
         active[static_cast<std::size_t>(band)] = project_tethers(state_, in_->tethers, strain, first, last);
-        if (boxes) box_rows(begin, end, *boxes);
+        if (boxes) box_rows(band, begin, end, *boxes);
     });
     std::size_t total = 0;
     for (std::size_t a : active) total += a;
@@ -461,22 +464,26 @@ bool MassSpring::box_blocks_on_team(StepProfile* profile, const BlockBounds* mad
     if (made && *made == bounds) return true;
     StageTimer timer(profile, Stage::BroadPhase);
     start_boxes(bounds);
-    in_->fast->for_each_band([&](int, int begin, int end) { box_rows(begin, end, bounds); });
+    in_->fast->for_each_band([&](int band, int begin, int end) { box_rows(band, begin, end, bounds); });
     return true;
 }
 
 void MassSpring::start_boxes(BlockBounds bounds) {
     in_->blocks.bounds = bounds;
     in_->blocks.boxes.resize(static_cast<std::size_t>(topology_.rows) * blocks_per_row(topology_.cols));
+    in_->blocks.band_union.fill(Box{});  // bands that box no row stay empty
+    in_->blocks.band_unions = true;
 }
 
-void MassSpring::box_rows(int begin, int end, BlockBounds bounds) {
+void MassSpring::box_rows(int band, int begin, int end, BlockBounds bounds) {
     const int cols = topology_.cols;
     const std::size_t per_row = blocks_per_row(cols);
+    Box* first = in_->blocks.boxes.data() + static_cast<std::size_t>(begin) * per_row;
     for (int r = begin; r < end; ++r) {
         row_block_bounds(state_.position, static_cast<std::size_t>(r) * cols, static_cast<std::size_t>(cols),
                          in_->blocks.boxes.data() + static_cast<std::size_t>(r) * per_row, bounds);
     }
+    in_->blocks.band_union[static_cast<std::size_t>(band)] = union_of(first, static_cast<std::size_t>(end - begin) * per_row);
 }
 
 bool MassSpring::sweep_takes_motion_bounds() const {

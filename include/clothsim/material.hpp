@@ -28,6 +28,7 @@ enum MaterialField : unsigned {
     kMaterialStretch = 2u,
     kMaterialShear = 4u,
     kMaterialBending = 8u,
+    kMaterialStretchCurve = 16u,
 };
 // Bits of Scene::per_spring_fields.
 enum PerSpringField : unsigned {
@@ -45,7 +46,12 @@ struct MaterialPreset {
     float shear;            // N/m
     glm::vec2 bending;      // N m: warp, weft
     std::string_view note;  // the fabric measured and where, one line
+    // Wang et al. 2011's stretching rows for a fabric they measured in full (its stretch curve); nullptr for a
+    // linear preset.
+    const WangStretching* stretching = nullptr;
 };
+// A preset's stretch curve: Wang et al.'s fitted model sampled (stretch_curve.hpp); empty (linear) otherwise.
+StretchCurve preset_stretch_curve(const MaterialPreset& preset);
 std::span<const MaterialPreset> material_presets();
 // By name, or by a name it had (material_preset_alias_note).
 const MaterialPreset* find_material_preset(std::string_view name);

@@ -32,11 +32,11 @@ public:
 };
 
 // ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
-using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, WindModel*,
-                              SolverMethod*, Integrator*, ContactModel*, ClothShape*>;
+using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, StretchCurve*,
+                              WindModel*, SolverMethod*, Integrator*, ContactModel*, ClothShape*>;
 using ConstFieldRef = std::variant<const int*, const float*, const bool*, const glm::vec2*, const glm::vec3*,
-                                   const std::string*, const PinSpec*, const WindModel*, const SolverMethod*,
-                                   const Integrator*, const ContactModel*, const ClothShape*>;
+                                   const std::string*, const PinSpec*, const StretchCurve*, const WindModel*,
+                                   const SolverMethod*, const Integrator*, const ContactModel*, const ClothShape*>;
 
 struct FieldInfo {
     std::string_view name;  // dotted name, as in the scene file and --set

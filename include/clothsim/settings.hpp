@@ -7,6 +7,7 @@
 
 #include "clothsim/collider.hpp"
 #include "clothsim/integrator.hpp"
+#include "clothsim/stretch_curve.hpp"
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -64,6 +65,7 @@ struct MaterialSettings {
     glm::vec2 stretch{5000.0f, 5000.0f};   // N/m: membrane tensile stiffness along u_axis (warp), v_axis (weft)
     float shear = 100.0f;                  // N/m: in-plane shear stiffness (per radian)
     glm::vec2 bending{1e-5f, 1e-5f};       // N m: flexural rigidity per unit width, bending along u, along v
+    StretchCurve stretch_curve;            // tangent stiffness over stretch past each strain; empty = linear
     // Which fields the scene sets itself (bit per MaterialField); the others follow the preset.
     unsigned explicit_fields = 0;
     bool operator==(const MaterialSettings&) const = default;
@@ -103,6 +105,9 @@ struct SpringSettings {
     // hangs from (tethers.hpp)
     float tether_strain = 0.0f;
     float tear_strain = 0.0f;  // fraction: 0 = off; otherwise a spring longer than (1 + it) L0 breaks (tearing.hpp)
+    // The structural springs' stretch curves along u_axis, along v_axis (stretch_curve.hpp): no knots = linear.
+    // Derived from material.stretch_curve on a grid cloth.
+    std::array<SpringCurve, 2> stretch_curve{};
     bool operator==(const SpringSettings&) const = default;
 };
 

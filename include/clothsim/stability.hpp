@@ -32,6 +32,10 @@ struct StabilityLimit {
     double omega_plane_wave = 0.0;  // rad/s, the tighter grid bound
     double critical_substep = 0.0;  // s: the largest stable substep by the Gershgorin bound and wind (inf: none)
     double plane_wave_substep = 0.0;  // s: the same with the plane-wave bound
+    // s: critical_substep with each curved spring (stretch_curve.hpp) at the tangent of the strain it has now
+    // instead of its curve's steepest; equal to it for a linear cloth. A cloth at rest could step at this
+    // substep; the bound is the stretched cloth's.
+    double at_strain_substep = 0.0;
     double wind_substep = 0.0;      // s: the explicit limit of the wind's drag, 1 / rate (inf without wind)
     bool unconditionally_stable = false;  // implicit Euler, XPBD
     StabilityBound bound = StabilityBound::Springs;

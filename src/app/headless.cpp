@@ -265,6 +265,7 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
         {"blew_up", run.blew_up()},
         {"blow_up", run.blew_up() ? nlohmann::json(run.cause()) : nlohmann::json()},
         {"critical_substep", finite_or_null(limit.critical_substep)},
+        {"critical_substep_at_strain", finite_or_null(stability_limit(sim).at_strain_substep)},  // at the end
         {"substep", sim.substep_length()},
         {"guard_log", run.guard_log},
         {"kinetic_energy", finite_or_null(e.kinetic)},

@@ -109,6 +109,26 @@ bool float_widget(const std::string& label, const FieldInfo& f, float* v) {
 // The pins: a preset picked in a combo (which drops the particles pinned by hand and keeps the preset's clip
 // radius), and below the presets whether clips hold softly. The preview shows the clip radius and how many pins
 // were added by hand ("top-corners, soft clip 0.03 m + 2").
+// material.stretch_curve: a checkbox between linear ({}) and the preset's measured curve (a curve of one's own
+// comes from the scene file or --set); the samples show as a tooltip.
+bool stretch_curve_toggle(const std::string& label, const Scene& edit, StretchCurve* v) {
+    const MaterialPreset* preset = find_material_preset(edit.material.preset);
+    const StretchCurve measured = preset ? preset_stretch_curve(*preset) : StretchCurve{};
+    bool curved = !v->empty();
+    const bool can = curved || !measured.empty();
+    ImGui::BeginDisabled(!can);
+    const bool changed = ImGui::Checkbox(label.c_str(), &curved);
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+        const FieldInfo* f = find_field("material.stretch_curve");
+        ImGui::SetTooltip("%s", v->empty() ? (can ? "linear: tick for the preset's measured curve"
+                                                  : "linear: this preset has no measured curve")
+                                           : format_value(edit, *f).c_str());
+    }
+    if (changed) *v = curved ? measured : StretchCurve{};
+    return changed;
+}
+
 bool pin_combo(const std::string& label, PinSpec* v) {
     const int preset = static_cast<int>(v->preset);
     const auto names = pin_preset_names();
@@ -189,6 +209,7 @@ bool value_widget(Scene& edit, const FieldInfo& f) {
                 return false;
             },
             [&](PinSpec* v) { return pin_combo(label, v); },
+            [&](StretchCurve* v) { return stretch_curve_toggle(label, edit, v); },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return enum_combo(label.c_str(), v, names_of(v)); },
         },
         f.ref(edit));
@@ -713,6 +734,11 @@ void stability_lines(AppState& app) {
     } else {
         ImGui::Text("critical substep %.4g ms (plane wave %.4g ms)", 1e3 * limit.critical_substep,
                     1e3 * limit.plane_wave_substep);
+    }
+    if (limit.at_strain_substep != limit.critical_substep) {
+        // A stretch curve: the bound is the stiffest tangent's; the cloth as it is now would allow more.
+        ImGui::TextDisabled("(%.4g ms at the strain it has now: the curve's steepest tangent bounds it)",
+                            1e3 * limit.at_strain_substep);
     }
     ImGui::TextColored(colour, "substep %.4g ms = %.2f of critical%s", 1e3 * substep, fraction,
                        auto_substeps ? " (auto)" : (fraction >= 1.0 ? ": may blow up" : ""));

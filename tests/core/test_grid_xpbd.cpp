@@ -86,6 +86,12 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
     material.material.stretch = {3000.0f, 1500.0f};
     material.material.bending = {2e-5f, 5e-6f};
     material.settings.forces.wind = {1.0f, 0.0f, 3.0f};
+    // Stretch curves whose knots the hanging cloth passes (stretch_curve.hpp: the secant compliance).
+    Scene curved = material;
+    curved.material.stretch_curve.u = {{0.0005f, 3.0f}, {0.002f, 8.0f}};
+    curved.material.stretch_curve.v = {{0.001f, 2.5f}};
+    curved.material.explicit_fields |= kMaterialStretchCurve;
+    derive_springs(curved);
     Scene disc = test::disc_specimen(15);
     test::collider(disc.settings.colliders, "sphere").enabled = true;
     test::sphere(disc.settings.colliders).center = {0.0f, 0.8f, 0.0f};
@@ -95,6 +101,7 @@ TEST_CASE("grid XPBD is the list-order XPBD on its elements listed in the grid's
         {"per-spring drape-sphere", xpbd_scene(per_spring_scene("drape-sphere"), 10, 17, 4)},
         {"material hanging", xpbd_scene(material, 12, 19, 8)},
         {"material disc", xpbd_scene(disc, 15, 15, 8)},
+        {"material hanging, curved", xpbd_scene(curved, 12, 19, 8)},
         // Three bands of rows and a part of one: the rows that reach into the next band come last.
         {"per-spring hanging, tall", xpbd_scene(per_spring_scene("hanging"), 2 * GridXpbd::kBandRows + 9, 9, 8)},
         {"material hanging, tall", xpbd_scene(material, 3 * GridXpbd::kBandRows + 1, 10, 8)},

@@ -82,17 +82,32 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
             if (damping_substep <= substep) bound = StabilityBound::Damping;
             substep = std::min(damping_substep, substep);
         }
-        limit.critical_substep = limit.plane_wave_substep = substep;
+        limit.critical_substep = limit.plane_wave_substep = limit.at_strain_substep = substep;
         limit.bound = bound;
         limit.unconditionally_stable = !std::isfinite(substep);
         limit.wind_substep = std::numeric_limits<double>::infinity();
         return limit;
     }
     std::vector<double> row_sum(state.size(), 0.0);
+    // A curved spring (stretch_curve.hpp) counts with the steepest tangent of its curve, so that the bound holds
+    // at any strain the cloth reaches; `at_strain` holds what its row sums lose at the tangent of the strain it has
+    // now (the at_strain_substep reported beside the bound).
+    double steepest_tangent = 1.0;
+    std::vector<double> at_strain;
     for (const Spring& s : topology.springs) {
         const double k = stiffness_of(settings.springs, s);
-        row_sum[s.a] += 2.0 * k;
-        row_sum[s.b] += 2.0 * k;
+        const SpringCurve& curve = curve_of(settings.springs, s);
+        double worst = 1.0;
+        if (curve.knots && s.rest_length > 0.0f) {
+            if (at_strain.empty()) at_strain.assign(state.size(), 0.0);
+            const double strain = glm::length(state.position.get(s.b) - state.position.get(s.a)) / s.rest_length - 1.0;
+            worst = curve.steepest();
+            steepest_tangent = std::max(steepest_tangent, worst);
+            at_strain[s.a] += 2.0 * k * (curve.tangent(strain) - worst);
+            at_strain[s.b] += 2.0 * k * (curve.tangent(strain) - worst);
+        }
+        row_sum[s.a] += 2.0 * k * worst;
+        row_sum[s.b] += 2.0 * k * worst;
     }
     // A bend's Hessian k w [1 -2 1]^T [1 -2 1] (x I): absolute row sums 4 k w on a and b, 8 k w on m.
     for (const Bend& b : topology.bends) {
@@ -109,15 +124,17 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         for (int i = 0; i < 4; ++i) row_sum[h.v[i]] += k * std::abs(double(h.c[i])) * total;
     }
     for (const SoftClipSpring& h : topology.clip_springs) row_sum[h.particle] += h.stiffness;
-    double gershgorin = 0.0;
+    double gershgorin = 0.0, gershgorin_now = 0.0;
     for (std::size_t i = 0; i < state.size(); ++i) {
         if (state.pinned[i]) continue;
         gershgorin = std::max(gershgorin, (row_sum[i] + contact_k) / state.mass[i]);
+        const double now = at_strain.empty() ? row_sum[i] : row_sum[i] + at_strain[i];
+        gershgorin_now = std::max(gershgorin_now, (now + contact_k) / state.mass[i]);
     }
     const SpringSettings& k = settings.springs;
     // A line of springs k has w^2 up to 4 k / m, a line of bends up to 16 k / m (the symbol (2 - 2 cos)^2).
     const double bending = std::max(k.bending.x, k.bending.y) * (topology.bends.empty() ? 1.0 : 4.0);
-    const double sum_k = double(std::max(k.structural.x, k.structural.y)) + double(k.shear) + bending;
+    const double sum_k = double(std::max(k.structural.x, k.structural.y)) * steepest_tangent + double(k.shear) + bending;
     limit.omega_gershgorin = std::sqrt(gershgorin);
     limit.omega_plane_wave = std::isfinite(lightest) ? std::sqrt((4.0 * sum_k + contact_k) / lightest + hold_rate) : 0.0;
     // A mesh cloth has no grid lines for a plane wave to run along, and its settings hold moduli, not springs'
@@ -126,6 +143,7 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
     const double factor = info.spring_factor;
     const DampingForm form = info.explicit_damping ? DampingForm::Explicit : DampingForm::None;
     limit.critical_substep = critical(limit.omega_gershgorin, settings.springs.damping, factor, form);
+    limit.at_strain_substep = critical(std::sqrt(gershgorin_now), settings.springs.damping, factor, form);
     limit.plane_wave_substep = critical(limit.omega_plane_wave, settings.springs.damping, factor, form);
     // Wind pressure on a particle's share of the area is a drag, F ~ drag A |w_rel| w_rel, whose rate
     // 2 drag A |w_rel| / m an explicit step must keep below about 1 per substep (forward Euler's limit on
@@ -145,10 +163,12 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         if (rate > 0.0) limit.wind_substep = 1.0 / rate;
     }
     limit.critical_substep = std::min(limit.critical_substep, limit.wind_substep);
+    limit.at_strain_substep = std::min(limit.at_strain_substep, limit.wind_substep);
     limit.plane_wave_substep = std::min(limit.plane_wave_substep, limit.wind_substep);
     if (info.damping_limit > 0.0 && c > 0.0) {
         // Its damping alone (RK4 on a pure decay rate c: c h < 2.785, its stability region on the real axis).
         limit.critical_substep = std::min(limit.critical_substep, info.damping_limit / c);
+        limit.at_strain_substep = std::min(limit.at_strain_substep, info.damping_limit / c);
         limit.plane_wave_substep = std::min(limit.plane_wave_substep, info.damping_limit / c);
     }
     return limit;

@@ -55,14 +55,15 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
 // Generic kernel: auto-vectorised for the baseline ISA.
 [[gnu::always_inline]] inline void spring_forces_generic(const double* __restrict x, const double* __restrict y,
                                                        const double* __restrict z, const float* __restrict rest,
-                                                       int offset, int begin, int end, float k, float* __restrict fx,
+                                                       int offset, int begin, int end, float k,
+                                                       const SpringCurve& curve, float* __restrict fx,
                                                        float* __restrict fy, float* __restrict fz) {
     for (int i = begin; i < end; ++i) {
         const float dx = static_cast<float>(x[i + offset] - x[i]);
         const float dy = static_cast<float>(y[i + offset] - y[i]);
         const float dz = static_cast<float>(z[i + offset] - z[i]);
         const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
-        const float stretched = k * (length - rest[i]) / length;
+        const float stretched = k * curve.stretch_term(length - rest[i], rest[i]) / length;
         const float s = rest[i] == 0.0f ? k : (length > 1e-12f ? stretched : 0.0f);
         fx[i - begin] = s * dx;
         fy[i - begin] = s * dy;
@@ -81,6 +82,7 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
 // its lanes only; the others compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx2,fma"))) inline void forces8(__m256 dx, __m256 dy, __m256 dz,
                                                                                 const float* rest, float k,
+                                                                                const SpringCurve& curve,
                                                                                 float* fx, float* fy, float* fz,
                                                                                 const __m256i* tail = nullptr) {
     const __m256 vk = _mm256_set1_ps(k), tiny = _mm256_set1_ps(1e-12f), zero = _mm256_setzero_ps();
@@ -88,7 +90,14 @@ int end_column(const Direction& d, int cols) { return cols - std::max(0, d.dc); 
                                     _mm256_mul_ps(dz, dz));
     const __m256 length = _mm256_sqrt_ps(r2);
     const __m256 l0 = tail ? _mm256_maskload_ps(rest, *tail) : _mm256_loadu_ps(rest);
-    const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, _mm256_sub_ps(length, l0)), length);
+    const __m256 e = _mm256_sub_ps(length, l0);
+    __m256 t = e;  // SpringCurve::stretch_term, lane by lane
+    for (std::uint32_t j = 0; j < curve.knots; ++j) {
+        const __m256 over = _mm256_sub_ps(e, _mm256_mul_ps(l0, _mm256_set1_ps(curve.strain[j])));
+        t = _mm256_blendv_ps(t, _mm256_add_ps(t, _mm256_mul_ps(_mm256_set1_ps(curve.gain[j]), over)),
+                             _mm256_cmp_ps(over, zero, _CMP_GT_OQ));
+    }
+    const __m256 stretched = _mm256_div_ps(_mm256_mul_ps(vk, t), length);
     const __m256 apart = _mm256_blendv_ps(zero, stretched, _mm256_cmp_ps(length, tiny, _CMP_GT_OQ));
     const __m256 s = _mm256_blendv_ps(apart, vk, _mm256_cmp_ps(l0, zero, _CMP_EQ_OQ));
     if (tail) {
@@ -141,17 +150,18 @@ struct DoubleHalves {
 // The AVX2 kernel: eight springs at a time, the last 1 to 7 in masked lanes.
 __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, const double* y, const double* z,
                                                              const float* rest, int offset, int begin, int end,
-                                                             float k, float* fx, float* fy, float* fz) {
+                                                             float k, const SpringCurve& curve, float* fx, float* fy,
+                                                             float* fz) {
     int i = begin;
     for (; i + 8 <= end; i += 8) {
         forces8(difference8_avx2(x, i, offset), difference8_avx2(y, i, offset), difference8_avx2(z, i, offset),
-                rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+                rest + i, k, curve, fx + (i - begin), fy + (i - begin), fz + (i - begin));
     }
     if (i < end) {  // the last 1 to 7 springs, in masked lanes
         const __m256i lanes = first_lanes8(end - i);
         const DoubleHalves halves = double_halves(lanes);
         forces8(difference8_avx2(x, i, offset, &halves), difference8_avx2(y, i, offset, &halves),
-                difference8_avx2(z, i, offset, &halves), rest + i, k, fx + (i - begin), fy + (i - begin),
+                difference8_avx2(z, i, offset, &halves), rest + i, k, curve, fx + (i - begin), fy + (i - begin),
                 fz + (i - begin), &lanes);
     }
 }
@@ -160,14 +170,21 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, con
 // less than all sixteen (a run's last springs) the rest lengths are read and the forces written in those
 // lanes only; the others compute on zeros and are dropped.
 [[gnu::always_inline]] __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) inline void forces16(
-    __m512 dx, __m512 dy, __m512 dz, const float* rest, float k, float* fx, float* fy, float* fz,
-    __mmask16 lanes = 0xFFFF) {
+    __m512 dx, __m512 dy, __m512 dz, const float* rest, float k, const SpringCurve& curve, float* fx, float* fy,
+    float* fz, __mmask16 lanes = 0xFFFF) {
     const __m512 vk = _mm512_set1_ps(k), tiny = _mm512_set1_ps(1e-12f), zero = _mm512_setzero_ps();
     const __m512 r2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
                                     _mm512_mul_ps(dz, dz));
     const __m512 length = _mm512_maskz_sqrt_ps(0xFFFF, r2);  // maskz: the unmasked form trips -Wmaybe-uninitialized
     const __m512 l0 = lanes == 0xFFFF ? _mm512_loadu_ps(rest) : _mm512_maskz_loadu_ps(lanes, rest);
-    const __m512 stretched = _mm512_div_ps(_mm512_mul_ps(vk, _mm512_sub_ps(length, l0)), length);
+    const __m512 e = _mm512_sub_ps(length, l0);
+    __m512 t = e;  // SpringCurve::stretch_term, lane by lane
+    for (std::uint32_t j = 0; j < curve.knots; ++j) {
+        const __m512 over = _mm512_sub_ps(e, _mm512_mul_ps(l0, _mm512_set1_ps(curve.strain[j])));
+        t = _mm512_mask_add_ps(t, _mm512_cmp_ps_mask(over, zero, _CMP_GT_OQ), t,
+                               _mm512_mul_ps(_mm512_set1_ps(curve.gain[j]), over));
+    }
+    const __m512 stretched = _mm512_div_ps(_mm512_mul_ps(vk, t), length);
     const __m512 apart = _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(length, tiny, _CMP_GT_OQ), stretched);
     const __m512 s = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(l0, zero, _CMP_EQ_OQ), apart, vk);
     if (lanes == 0xFFFF) {
@@ -191,16 +208,17 @@ __attribute__((target("avx2,fma"))) void spring_forces_avx2(const double* x, con
 
 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) void spring_forces_avx512(
     const double* x, const double* y, const double* z, const float* rest, int offset, int begin, int end, float k,
-    float* fx, float* fy, float* fz) {
+    const SpringCurve& curve, float* fx, float* fy, float* fz) {
     int i = begin;
     for (; i + 16 <= end; i += 16) {
         forces16(difference16_avx512(x, i, offset), difference16_avx512(y, i, offset),
-                 difference16_avx512(z, i, offset), rest + i, k, fx + (i - begin), fy + (i - begin), fz + (i - begin));
+                 difference16_avx512(z, i, offset), rest + i, k, curve, fx + (i - begin), fy + (i - begin),
+                 fz + (i - begin));
     }
     if (i < end) {  // the last 1 to 15 springs, in masked lanes
         const auto lanes = static_cast<__mmask16>((1u << (end - i)) - 1u);
         forces16(difference16_avx512(x, i, offset, lanes), difference16_avx512(y, i, offset, lanes),
-                 difference16_avx512(z, i, offset, lanes), rest + i, k, fx + (i - begin), fy + (i - begin),
+                 difference16_avx512(z, i, offset, lanes), rest + i, k, curve, fx + (i - begin), fy + (i - begin),
                  fz + (i - begin), lanes);
     }
 }
@@ -555,6 +573,8 @@ struct Grid {
     std::size_t row_floats() const { return 18 * stride(); }
 };
 
+constexpr SpringCurve kLinearCurve{};
+
 constexpr bool kind_runs(unsigned mask, SpringKind kind) { return (mask >> static_cast<int>(kind)) & 1u; }
 
 // Directions of a kind the plan skips are neither computed nor written: integrate_row<Mask> never reads them.
@@ -580,6 +600,7 @@ template <FastKernel K, unsigned Mask>
         const int row_start = r * grid.cols;
         const int offset = dir.dr * grid.cols + dir.dc;
         const float k = stiffness[d] * grid.row_weight[d][r];
+        const SpringCurve& curve = d < 2 ? springs.stretch_curve[d] : kLinearCurve;
         const double* x = state.position.x.data();
         const double* y = state.position.y.data();
         const double* z = state.position.z.data();
@@ -594,13 +615,13 @@ template <FastKernel K, unsigned Mask>
                 bend_forces_generic(x, y, z, half, begin, end, k, f + c0, f + stride + c0, f + 2 * stride + c0);
             }
         } else if constexpr (K == FastKernel::Avx512) {
-            spring_forces_avx512(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+            spring_forces_avx512(x, y, z, grid.rest[d].data(), offset, begin, end, k, curve, f + c0, f + stride + c0,
                                  f + 2 * stride + c0);
         } else if constexpr (K == FastKernel::Avx2) {
-            spring_forces_avx2(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+            spring_forces_avx2(x, y, z, grid.rest[d].data(), offset, begin, end, k, curve, f + c0, f + stride + c0,
                                f + 2 * stride + c0);
         } else {
-            spring_forces_generic(x, y, z, grid.rest[d].data(), offset, begin, end, k, f + c0, f + stride + c0,
+            spring_forces_generic(x, y, z, grid.rest[d].data(), offset, begin, end, k, curve, f + c0, f + stride + c0,
                                   f + 2 * stride + c0);
         }
         for (int i = grid.fix_begin[d][r]; i < grid.fix_begin[d][r + 1]; ++i) {

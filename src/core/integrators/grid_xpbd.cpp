@@ -1,4 +1,5 @@
 #include "integrators/grid_xpbd.hpp"
+#include "integrators/xpbd_projection.hpp"
 
 #include "integrators/fast_solver.hpp"
 #include "integrators/work_team.hpp"
@@ -33,8 +34,11 @@ struct Particles {
 // The arithmetic is step_xpbd's: d = x_b - x_a, |d| = sqrt((dx dx + dy dy) + dz dz),
 // lambda = -(|d| - L0) / ((w_a + w_b) + alpha), g = lambda / |d|, x_a -= w_a g d, x_b += w_b g d; nothing
 // for a spring without stiffness (alpha infinite) or whose ends coincide. Returns the sum of C^2.
+// With a stretch curve (Curved), each spring takes its secant compliance as step_xpbd does (xpbd_projection.hpp).
+template <bool Curved = false>
 [[gnu::always_inline]] inline double project_springs(const Particles& p, const float* rest, const double* alpha,
-                                                     double* lambda, int first, int last, int offset) {
+                                                     double* lambda, int first, int last, int offset,
+                                                     const SpringCurve* curve = nullptr) {
     double* x = p.x;
     double* y = p.y;
     double* z = p.z;
@@ -47,7 +51,8 @@ struct Particles {
         const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
         const double c = length - static_cast<double>(rest[i]);
         const double wa = w[i], wb = w[j];
-        const double l = -c / ((wa + wb) + alpha[i]);
+        const double a = Curved ? curved_compliance(alpha[i], *curve, c, static_cast<double>(rest[i])) : alpha[i];
+        const double l = -c / ((wa + wb) + a);
         const bool ok = (length > 1e-12) & (alpha[i] < kInfinite);
         const double g = ok ? l / length : 0.0;
         lambda[i] = ok ? l : 0.0;
@@ -103,10 +108,10 @@ constexpr int along_count(int cols, int span, int phase) { return std::max(0, (c
 
 // The springs along row `row` from column c to c + Span whose column is `phase` modulo Span + 1: no two share a
 // particle. `first_slot` is the pass's first slot in the row; arithmetic as project_springs.
-template <int Span>
+template <int Span, bool Curved = false>
 [[gnu::always_inline]] inline double project_row_springs(const Particles& p, const float* rest, const double* alpha,
                                                          double* lambda, int row, int cols, int phase, int first_slot,
-                                                         int first = 0) {
+                                                         int first = 0, const SpringCurve* curve = nullptr) {
     double* x = p.x + row + phase;
     double* y = p.y + row + phase;
     double* z = p.z + row + phase;
@@ -121,7 +126,8 @@ template <int Span>
         const double length = std::sqrt((dx * dx + dy * dy) + dz * dz);
         const double e = length - static_cast<double>(rest[k]);
         const double wa = w[a], wb = w[b];
-        const double l = -e / ((wa + wb) + alpha[k]);
+        const double ak = Curved ? curved_compliance(alpha[k], *curve, e, static_cast<double>(rest[k])) : alpha[k];
+        const double l = -e / ((wa + wb) + ak);
         const bool ok = (length > 1e-12) & (alpha[k] < kInfinite);
         const double g = ok ? l / length : 0.0;
         lambda[k] = ok ? l : 0.0;
@@ -179,6 +185,7 @@ struct Pass {
     std::array<std::vector<double>, 6>* lambda;
     std::array<DVec3Array, 2>* bend_lambda;
     const std::array<std::array<int, 3>, 2>* first_slot;  // GridXpbd::first_slot_
+    const std::array<SpringCurve, 2>* curve;              // the structural springs' along u (d = 0), along v (d = 1)
 };
 
 // The stages of a pass, in order (the header's): the elements of one direction. Along a row (Along*) each
@@ -192,19 +199,32 @@ enum class Stage { AlongSprings, Down, DownRight, DownLeft, AlongSkipOne, DownSk
     // Both lambdas are forced inline: a lambda left out of line is compiled for the baseline instruction set,
     // not for the kernel's (project_avx2 and project_avx512 below).
     auto down = [&](int d, int first_col, int last_col) __attribute__((always_inline)) {
+        const SpringCurve* curve = d == 1 && (*pass.curve)[1].knots ? &(*pass.curve)[1] : nullptr;
         for (int r = first_row; r < last_row; ++r) {
-            violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
-                                          (*pass.lambda)[d].data(), r * cols + first_col, r * cols + last_col,
-                                          kDirections[d].dr * cols + kDirections[d].dc);
+            if (curve) {
+                violation2 += project_springs<true>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                                    (*pass.lambda)[d].data(), r * cols + first_col, r * cols + last_col,
+                                                    kDirections[d].dr * cols + kDirections[d].dc, curve);
+            } else {
+                violation2 += project_springs(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                              (*pass.lambda)[d].data(), r * cols + first_col, r * cols + last_col,
+                                              kDirections[d].dr * cols + kDirections[d].dc);
+            }
         }
     };
     // Springs along the rows, two apart when Span is 2: every (Span + 1)th column per pass.
     auto along = [&]<int Span>(int d) __attribute__((always_inline)) {
         for (int r = first_row; r < last_row; ++r) {
             for (int phase = 0; phase <= Span; ++phase) {
-                violation2 += project_row_springs<Span>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
-                                                        (*pass.lambda)[d].data(), r * cols, cols, phase,
-                                                        (*pass.first_slot)[Span - 1][phase]);
+                if (d == 0 && (*pass.curve)[0].knots) {
+                    violation2 += project_row_springs<Span, true>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                                                  (*pass.lambda)[d].data(), r * cols, cols, phase,
+                                                                  (*pass.first_slot)[Span - 1][phase], 0, &(*pass.curve)[0]);
+                } else {
+                    violation2 += project_row_springs<Span>(pass.p, (*pass.rest)[d].data(), (*pass.alpha)[d].data(),
+                                                            (*pass.lambda)[d].data(), r * cols, cols, phase,
+                                                            (*pass.first_slot)[Span - 1][phase]);
+                }
             }
         }
     };
@@ -388,15 +408,16 @@ __attribute__((target("avx2,fma"))) double along_bends_avx2(const Pass& pass, in
 double project_generic(const Pass& pass, Stage stage, int first, int last) {
     return project_rows(pass, stage, first, last);
 }
+// A curved material's springs along the rows take the scalar order (project_rows), the same arithmetic.
 __attribute__((target("avx2,fma"))) double project_avx2(const Pass& pass, Stage stage, int first, int last) {
-    if (stage == Stage::AlongSprings) return along_springs_avx2(pass, first, last);
+    if (stage == Stage::AlongSprings && !(*pass.curve)[0].knots) return along_springs_avx2(pass, first, last);
     if (stage == Stage::AlongBends) return along_bends_avx2(pass, first, last);
     return project_rows(pass, stage, first, last);
 }
 // The passes along the rows as AVX2's (four lanes are enough for their shuffles).
 __attribute__((target("avx512f,avx512vl,avx2,fma"))) double project_avx512(const Pass& pass, Stage stage, int first,
                                                                            int last) {
-    if (stage == Stage::AlongSprings) return along_springs_avx2(pass, first, last);
+    if (stage == Stage::AlongSprings && !(*pass.curve)[0].knots) return along_springs_avx2(pass, first, last);
     if (stage == Stage::AlongBends) return along_bends_avx2(pass, first, last);
     return project_rows(pass, stage, first, last);
 }
@@ -566,6 +587,7 @@ void GridXpbd::set_stiffness(const Topology& topology, const SpringSettings& spr
             present_[d] = present_[d] || k > 0.0f;
         }
     }
+    curve_ = springs.stretch_curve;
     alpha_h_ = 0.0;  // alpha_ follows at the next substep
 }
 
@@ -626,7 +648,7 @@ void GridXpbd::step(State& state, const Dynamics& dynamics, double h, int thread
     double* mz = state.motion.z.data();
     const float* w = state.inverse_mass.data();
     const std::uint8_t* pinned = state.pinned.data();
-    const Pass pass{{x, y, z, w}, rows_, cols_, &rest_, &alpha_, &lambda_, &bend_lambda_, &first_slot_};
+    const Pass pass{{x, y, z, w}, rows_, cols_, &rest_, &alpha_, &lambda_, &bend_lambda_, &first_slot_, &curve_};
     WorkTeam& work_team = WorkTeam::shared();
     // Particles in chunks of kParticleChunk, rows in chunks of kRowChunk: pieces small enough that a
     // descheduled thread holds up little (work_team.hpp).
@@ -706,7 +728,9 @@ double GridXpbd::residual(const DVec3Array& position) const {
                 residual2 += glm::dot(r, r);
             } else {
                 const double c = glm::length(position.get(i + offset) - position.get(i)) - rest_[d][e];
-                const double r = c + lambda_[d][e] / (k * h2);
+                const SpringCurve& curve = d < 2 ? curve_[d] : SpringCurve{};
+                const double r = curve.knots == 0 ? c + lambda_[d][e] / (k * h2)
+                                                  : c + lambda_[d][e] * curved_compliance(1.0 / (k * h2), curve, c, rest_[d][e]);
                 residual2 += r * r;
             }
         }

@@ -79,6 +79,7 @@ private:
     std::array<std::array<int, 3>, 2> first_slot_{};  // [span - 1][phase]: a pass's first slot in a row
     std::array<bool, 6> present_{};              // some element has k > 0 in direction d
     double alpha_h_ = 0.0;                       // the substep alpha_ is for (0: not set)
+    std::array<SpringCurve, 2> curve_{};        // the structural springs' stretch curves (set_stiffness)
     double substep_ = 0.0;                       // the last substep's length, 0 before one
     double initial_violation_ = 0.0;
     // Scratch kept across substeps.

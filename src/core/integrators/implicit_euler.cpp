@@ -29,9 +29,18 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
         } else {
             if (!(length > 1e-12f)) continue;
             const glm::vec3 n = d / length;
-            const float alpha = std::max(0.0f, 1.0f - s.rest_length / length);
+            const SpringCurve& curve = curve_of(springs, s);
             const glm::vec3 along = glm::dot(n, du) * n;
-            f = k * (along + alpha * (du - along));
+            if (curve.knots == 0) {
+                const float alpha = std::max(0.0f, 1.0f - s.rest_length / length);
+                f = k * (along + alpha * (du - along));
+            } else {
+                // A curved spring (stretch_curve.hpp): along d its tangent k t'(e), across it k t(e) / |d|.
+                const float e = length - s.rest_length;
+                const float tangent = static_cast<float>(curve.tangent(double(e) / double(s.rest_length)));
+                const float alpha = std::max(0.0f, curve.stretch_term(e, s.rest_length) / length);
+                f = k * (tangent * along + alpha * (du - along));
+            }
         }
         out.add(s.a, f);
         out.add(s.b, -f);

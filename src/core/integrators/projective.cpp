@@ -270,9 +270,19 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
             const glm::dvec3 d = position.get(s.b) - position.get(s.a);
             const double length = glm::length(d);
             const double stretch = length - s.rest_length;
-            e += 0.5 * k * stretch * stretch;
+            const SpringCurve& curve = curve_of(springs, s);
+            if (curve.knots == 0) {
+                e += 0.5 * k * stretch * stretch;
+            } else {
+                e += k * curve.energy_term(stretch, s.rest_length);
+            }
             if (s.rest_length == 0.0f || !(length > 1e-12)) continue;
-            const glm::dvec3 kd = d * (k * s.rest_length / length);
+            // A curved spring's target length is |d| - t(|d| - L0) instead of L0, so that k (d - d_s) is its
+            // force: the constant matrix with the true gradient (Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods
+            // for real-time simulation of hyperelastic materials").
+            const double target_length =
+                curve.knots == 0 ? double(s.rest_length) : length - curve.stretch_term(stretch, double(s.rest_length));
+            const glm::dvec3 kd = d * (k * target_length / length);
             const int ra = f.free_index[s.a], rb = f.free_index[s.b];
             if (ra >= 0) rhs.row(ra) -= Eigen::RowVector3d(kd.x, kd.y, kd.z);
             if (rb >= 0) rhs.row(rb) += Eigen::RowVector3d(kd.x, kd.y, kd.z);

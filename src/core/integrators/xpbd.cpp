@@ -34,7 +34,10 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     double violation2 = 0.0;
     for (std::size_t j = 0; j < topology.springs.size(); ++j) {
         const double k = stiffness_of(springs, topology.springs[j]);
-        if (k != 0.0) violation2 += project_spring(state, topology.springs[j], k, h, multipliers.spring[j]);
+        if (k != 0.0) {
+            violation2 += project_spring(state, topology.springs[j], k, h, multipliers.spring[j],
+                                         curve_of(springs, topology.springs[j]));
+        }
     }
     for (std::size_t j = 0; j < topology.bends.size(); ++j) {
         const double k = stiffness_of(springs, topology.bends[j]);
@@ -64,7 +67,9 @@ double xpbd_residual(const DVec3Array& position, const Topology& topology, const
         const double k = stiffness_of(springs, s);
         if (k == 0.0) continue;
         const double c = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
-        const double r = c + multipliers.spring[j] / (k * h2);
+        const SpringCurve& curve = curve_of(springs, s);
+        const double r = curve.knots == 0 ? c + multipliers.spring[j] / (k * h2)
+                                          : c + multipliers.spring[j] * curved_compliance(1.0 / (k * h2), curve, c, s.rest_length);
         residual2 += r * r;
     }
     for (std::size_t j = 0; j < topology.bends.size(); ++j) {

@@ -18,21 +18,32 @@ namespace clothsim {
 // A spring from particle a to b, C = |x_b - x_a| - L0, with compliance alpha~ = 1 / (k h^2):
 // d_lambda = -C / (w_a + w_b + alpha~), and x_a -= w_a lambda n, x_b += w_b lambda n with n = d / |d|, computed as
 // lambda / |d| times d. Leaves `lambda` alone where the spring has no length to project along.
+// A structural spring with a stretch curve (stretch_curve.hpp) takes the compliance of its secant stiffness at
+// the C it is projected from, k t(C) / C: alpha C / t(C). At the fixed point C + alpha~ lambda = 0 its force
+// -lambda / h^2 is then k t(C), the curve's; a linear or compressed spring keeps alpha (t(C) = C).
+inline double curved_compliance(double alpha, const SpringCurve& curve, double c, double rest_length) {
+    if (curve.knots == 0 || !(c > 0.0)) return alpha;
+    return alpha * (c / curve.stretch_term(c, rest_length));
+}
+
 inline double project_spring(State& state, std::size_t a, std::size_t b, double rest_length, double alpha,
-                             double& lambda) {
+                             double& lambda, const SpringCurve* curve = nullptr) {
     const double wa = state.inverse_mass[a], wb = state.inverse_mass[b];
     const glm::dvec3 d = state.position.get(b) - state.position.get(a);
     const double length = std::sqrt((d.x * d.x + d.y * d.y) + d.z * d.z);
     if (!(length > 1e-12)) return 0.0;
     const double c = length - rest_length;
+    if (curve) alpha = curved_compliance(alpha, *curve, c, rest_length);
     lambda = -c / ((wa + wb) + alpha);
     const double g = lambda / length;
     state.position.add(a, d * -(wa * g));
     state.position.add(b, d * (wb * g));
     return c * c;
 }
-inline double project_spring(State& state, const Spring& s, double k, double h, double& lambda) {
-    return project_spring(state, s.a, s.b, static_cast<double>(s.rest_length), 1.0 / (k * h * h), lambda);
+inline double project_spring(State& state, const Spring& s, double k, double h, double& lambda,
+                             const SpringCurve& curve) {
+    return project_spring(state, s.a, s.b, static_cast<double>(s.rest_length), 1.0 / (k * h * h), lambda,
+                          curve.knots ? &curve : nullptr);
 }
 
 // A bend: the vector constraint C = x_a - 2 x_m + x_b with gradients I, -2 I, I:

@@ -23,7 +23,7 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
         } else {
             const T length = glm::length(d);
             if (!(length > T(1e-12f))) continue;
-            scale = ks * (length - rest) / length;
+            scale = ks * curve_of(springs, s).stretch_term(length - rest, rest) / length;
         }
         const Vec f = scale * d;
         force.add(s.a, f);
@@ -108,7 +108,8 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
     for (const Spring& s : topology.springs) {
         const double k = stiffness_of(springs, s);
         const double stretch = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
-        energy += 0.5 * k * stretch * stretch;
+        const SpringCurve& curve = curve_of(springs, s);
+        energy += curve.knots == 0 ? 0.5 * k * stretch * stretch : k * curve.energy_term(stretch, s.rest_length);
     }
     for (const Bend& b : topology.bends) {
         const glm::dvec3 d = bend_difference(position, b);

@@ -9,7 +9,8 @@
 
 namespace clothsim {
 
-// Hooke springs, F_a = k w (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b; then the bends
+// Hooke springs, F_a = k w (|d| - L0) d/|d| with d = x_b - x_a, and -F_a on b (a structural spring with a
+// stretch curve: k w t(|d| - L0) d/|d|, t its SpringCurve::stretch_term); then the bends
 // (spring.hpp): with d = x_a - 2 x_m + x_b, F_a = F_b = -k w d and F_m = 2 k w d; then the hinges: with
 // d = sum_i c_i x_i, F_i = -k c_i d. A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
@@ -56,6 +57,15 @@ inline float stiffness_of(const SpringSettings& springs, SpringKind kind, Axis a
 // A spring's k w and a bend's k w: products with a power-of-two weight, exact in float.
 inline float stiffness_of(const SpringSettings& springs, const Spring& s) {
     return stiffness_of(springs, s.kind, s.axis) * s.weight;
+}
+// A spring's stretch curve (stretch_curve.hpp): its axis's for a structural spring, none (linear) otherwise.
+inline const SpringCurve& curve_of(const SpringSettings& springs, SpringKind kind, Axis axis) {
+    static const SpringCurve kLinear{};
+    if (kind != SpringKind::Structural || axis == Axis::Diagonal) return kLinear;
+    return springs.stretch_curve[axis == Axis::V ? 1 : 0];
+}
+inline const SpringCurve& curve_of(const SpringSettings& springs, const Spring& s) {
+    return curve_of(springs, s.kind, s.axis);
 }
 inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
     return stiffness_of(springs, SpringKind::Bending, b.axis) * b.weight;

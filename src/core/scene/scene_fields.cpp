@@ -46,6 +46,7 @@ const std::array kFields = {
     FieldInfo{"material.density", "kg/m^2", 1e-3, 100, "areal density (mass per area)", [](Scene& s) -> FieldRef { return &s.material.density; }},
     FieldInfo{"material.stretch", "N/m", 1e-2, 1e7, "membrane tensile stiffness (force per width per strain): one number, or [warp along u_axis, weft along v_axis]", [](Scene& s) -> FieldRef { return &s.material.stretch; }},
     FieldInfo{"material.shear", "N/m", 0, 1e7, "in-plane shear stiffness (force per width per radian of shear)", [](Scene& s) -> FieldRef { return &s.material.shear; }},
+    FieldInfo{"material.stretch_curve", "", 0, 1e4, "nonlinear stretch of a grid cloth: { u = [[strain, factor], ...], v = [...] }, from each strain on (increasing, in (0, 1]) the tensile tangent stiffness is factor x material.stretch; {} = linear (Wang et al. presets carry their measured curves)", [](Scene& s) -> FieldRef { return &s.material.stretch_curve; }},
     FieldInfo{"material.bending", "N m", 0, 10, "flexural rigidity per unit width: one number, or [bending along u, along v]", [](Scene& s) -> FieldRef { return &s.material.bending; }},
 
     FieldInfo{"springs.structural", "N/m", 0, 1e9, "stiffness of each horizontal and vertical neighbour spring: one number, or [along u_axis, along v_axis] (derived from [material] when the scene has one)", [](Scene& s) -> FieldRef { return &s.settings.springs.structural; }},
@@ -167,6 +168,10 @@ std::string describe_allowed_as(std::string_view unit_name, double min, double m
                            "radius, particles and clip (rigid or soft); R: ",
                            describe_pin_radius(), " (0 = a point pin)");
             },
+            [&](StretchCurve*) {
+                return std::string("{ u = [[strain, factor], ...], v = [...] } with at most 8 samples a direction, "
+                                   "strains increasing in (0, 1], factors in (0, 1e4]; {} = linear");
+            },
             [&]<class Enum>(Enum* v) requires std::is_enum_v<Enum> { return "one of " + join(names_of(v)); },
         },
         sample);
@@ -246,6 +251,15 @@ std::string format_ref(ConstFieldRef value) {
                 }
                 return cat(out, ", particles = [", list, "] }");
             },
+            [&](const StretchCurve* v) {
+                auto list = [](const std::vector<StretchSample>& samples) {
+                    std::string out;
+                    for (const StretchSample& s : samples) out += cat(out.empty() ? "" : ", ", "[", number(s.strain), ", ", number(s.factor), "]");
+                    return cat("[", out, "]");
+                };
+                if (v->empty()) return std::string("{}");
+                return cat("{ u = ", list(v->u), ", v = ", list(v->v), " }");
+            },
             [&]<class Enum>(const Enum* v) requires std::is_enum_v<Enum> { return quoted(names_of(v)[static_cast<int>(*v)]); },
         },
         value);
@@ -297,6 +311,18 @@ void validate(const Scene& scene) {
     }
     if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
     if (scene.material.enabled && !c.is_mesh()) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive
+    if (scene.material.enabled) {
+        const StretchCurve& curve = scene.material.stretch_curve;
+        for (const auto& [axis, samples] : {std::pair{"u", &curve.u}, std::pair{"v", &curve.v}}) {
+            if (const std::string problem = stretch_samples_problem(*samples); !problem.empty()) {
+                throw SceneError(cat("material.stretch_curve.", axis, ": ", problem));
+            }
+        }
+        if (c.is_mesh() && (scene.material.explicit_fields & kMaterialStretchCurve) && !curve.empty()) {
+            throw SceneError("material.stretch_curve is set on a mesh cloth, whose edge springs mix warp and weft; "
+                             "allowed on a mesh cloth: {} (linear; docs/MATERIAL.md, \"Nonlinear stretch\")");
+        }
+    }
     const ColliderSettings& colliders = scene.settings.colliders;
     if (colliders.contact == ContactModel::Penalty && !(colliders.thickness > 0.0f)) {
         throw SceneError("colliders.thickness = " + format_value(scene, *find_field("colliders.thickness")) +

@@ -264,6 +264,39 @@ std::optional<PinSpec> pins_of(const toml::node& node, Rejection& rejection) {
     return std::nullopt;
 }
 
+// material.stretch_curve: a table { u = [[strain, factor], ...], v = [...] }, either key optional ({} is linear).
+// The samples' order and ranges are validate()'s (stretch_samples_problem).
+std::optional<StretchCurve> stretch_curve_of(const toml::node& node, Rejection& rejection) {
+    const toml::table* table = node.as_table();
+    if (!table) return std::nullopt;
+    StretchCurve curve;
+    for (auto&& [key, value] : *table) {
+        const std::string name = "material.stretch_curve." + std::string(key.str());
+        std::vector<StretchSample>* samples = key.str() == "u" ? &curve.u : key.str() == "v" ? &curve.v : nullptr;
+        if (!samples) {
+            rejection = {"material.stretch_curve has an unknown key '" + std::string(key.str()) + "'; allowed keys: u, v",
+                         &value};
+            return std::nullopt;
+        }
+        const toml::array* array = value.as_array();
+        if (!array) {
+            rejection = {name + " = " + show(value) + " is not a list; allowed: a list of [strain, factor]", &value};
+            return std::nullopt;
+        }
+        for (std::size_t i = 0; i < array->size(); ++i) {
+            const auto pair = numbers_of(*array->get(i), 2);
+            if (!pair || !std::isfinite((*pair)[0]) || !std::isfinite((*pair)[1])) {
+                rejection = {name + "[" + std::to_string(i) + "] = " + show(*array->get(i)) +
+                                 " is not a sample; allowed: [strain, factor], two numbers",
+                             array->get(i)};
+                return std::nullopt;
+            }
+            samples->push_back({static_cast<float>((*pair)[0]), static_cast<float>((*pair)[1])});
+        }
+    }
+    return curve;
+}
+
 // Sets one field from a TOML node. Returns false (and leaves the scene alone) when the node's type or
 // value is not allowed, saying why in `rejection` where it can; validate() checks cross-field rules afterwards.
 bool assign_to(FieldRef target_ref, double min, double max, const toml::node& node, Rejection& rejection) {
@@ -313,6 +346,12 @@ bool assign_to(FieldRef target_ref, double min, double max, const toml::node& no
             },
             [&](PinSpec* target) {
                 const auto v = pins_of(node, rejection);
+                if (!v) return false;
+                *target = *v;
+                return true;
+            },
+            [&](StretchCurve* target) {
+                const auto v = stretch_curve_of(node, rejection);
                 if (!v) return false;
                 *target = *v;
                 return true;

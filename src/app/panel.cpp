@@ -435,6 +435,15 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
                           "per spring and a material rebuilds the cloth");
     }
     if (result != FabricEdit::None) return result;
+    if (edit.material.enabled && !app.sim.topology().mesh) {
+        // The stretch curve on the fabric's own row (SameLine: nothing below moves): linear or the preset's
+        // measured curve (docs/MATERIAL.md, "Nonlinear stretch").
+        ImGui::SameLine();
+        if (stretch_curve_toggle("curved", edit, &edit.material.stretch_curve)) {
+            note_edit(edit, *find_field("material.stretch_curve"));
+            return FabricEdit::Live;
+        }
+    }
     if (edit.material.enabled) {
         if (named_fields(edit, app, {"material.density", "material.stretch", "material.shear", "material.bending"})) {
             result = FabricEdit::Live;
@@ -736,9 +745,15 @@ void stability_lines(AppState& app) {
                     1e3 * limit.plane_wave_substep);
     }
     if (limit.at_strain_substep != limit.critical_substep) {
-        // A stretch curve: the bound is the stiffest tangent's; the cloth as it is now would allow more.
-        ImGui::TextDisabled("(%.4g ms at the strain it has now: the curve's steepest tangent bounds it)",
-                            1e3 * limit.at_strain_substep);
+        // A stretch curve: the bound is its steepest tangent's; the cloth as it is now would allow more. Marked
+        // on the line (SameLine: nothing below moves).
+        ImGui::SameLine();
+        ImGui::TextDisabled("(i)");
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("%.4g ms at the strain the cloth has now: the stretch curve's steepest tangent\n"
+                              "bounds the substep, so that it holds at any strain (docs/MATERIAL.md)",
+                              1e3 * limit.at_strain_substep);
+        }
     }
     ImGui::TextColored(colour, "substep %.4g ms = %.2f of critical%s", 1e3 * substep, fraction,
                        auto_substeps ? " (auto)" : (fraction >= 1.0 ? ": may blow up" : ""));

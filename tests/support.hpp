@@ -1,7 +1,9 @@
 // Small scene builders shared by the physics tests.
 #pragma once
 
+#include "clothsim/material.hpp"
 #include "clothsim/scene.hpp"
+#include "clothsim/stability.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -229,6 +231,44 @@ inline Scene scene_for_loops(std::string_view name) {
     Scene s = load_scene(name);
     if (const CostlyScene* c = costly_scene(name)) s.cloth.rows = s.cloth.cols = c->loop_side;
     return s;
+}
+
+// A tensile test specimen: a square sheet of `per_side` particles, 0.3 m a side, of `material`, no gravity or
+// ground, held by its first and last columns (along u) or rows (along v), the far one moved out by `strain`,
+// then settled: damped at critical for its slowest in-plane mode at `stiffness` (N/m; w ~ pi sqrt(S /
+// density) / side) and run to e^-20 at `safety` of the critical substep.
+inline MassSpring pulled_sheet(int per_side, bool along_u, const MaterialSettings& material, double strain,
+                               double stiffness, float safety) {
+    Scene s;
+    const float side = 0.3f;
+    s.cloth.rows = s.cloth.cols = per_side;
+    s.cloth.size = {side, side};
+    s.cloth.origin = {0.0f, 0.0f, 0.0f};
+    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
+    s.cloth.v_axis = {0.0f, 1.0f, 0.0f};
+    s.pins.preset = along_u ? PinPreset::LeftEdge : PinPreset::TopRow;
+    s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
+    collider(s.settings.colliders, "ground").enabled = false;
+    s.settings.solver.sleep_speed = 0.0f;
+    s.material = material;
+    s.material.enabled = true;
+    derive_springs(s);
+    MassSpring sim = build_simulation(s);
+    for (int i = 0; i < per_side; ++i) {
+        const std::size_t p = along_u ? static_cast<std::size_t>(i) * per_side + per_side - 1
+                                      : static_cast<std::size_t>(per_side - 1) * per_side + i;
+        sim.set_pinned(p, true);
+        glm::vec3 x = sim.position(p);
+        (along_u ? x.x : x.y) *= static_cast<float>(1.0 + strain);
+        sim.move_pinned(p, x);
+    }
+    const double w = 3.14159 * std::sqrt(stiffness / double(material.density)) / side;
+    SimulationSettings settings = sim.settings();
+    settings.springs.damping = static_cast<float>(2.0 * w);
+    sim.apply(settings);
+    sim.set_substeps(auto_substeps(stability_limit(sim), settings.integration.dt, safety, 1));
+    sim.run_steps(static_cast<long long>(std::ceil(20.0 / w / settings.integration.dt)));
+    return sim;
 }
 
 }  // namespace clothsim::test

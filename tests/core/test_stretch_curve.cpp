@@ -145,49 +145,22 @@ TEST_CASE("stretch curve: a hanging chain settles at the curve's inverse of each
 
 namespace {
 
-// A square sheet, 0.3 m a side, no gravity, held by its first and last columns (along u) or rows (along v),
-// the far one moved out by `strain` and settled: its elastic energy per area.
+// A sheet pulled along u or v to `strain` through the curve's knots (test::pulled_sheet, settled at its
+// steepest tangent): its elastic energy per area.
 double tensile_energy(int per_side, bool along_u, const StretchCurve& curve, double strain) {
-    Scene s;
-    const float side = 0.3f;
-    s.cloth.rows = s.cloth.cols = per_side;
-    s.cloth.size = {side, side};
-    s.cloth.origin = {0.0f, 0.0f, 0.0f};
-    s.cloth.u_axis = {1.0f, 0.0f, 0.0f};
-    s.cloth.v_axis = {0.0f, 1.0f, 0.0f};
-    s.pins.preset = along_u ? PinPreset::LeftEdge : PinPreset::TopRow;
-    s.settings.forces.gravity = {0.0f, 0.0f, 0.0f};
-    test::collider(s.settings.colliders, "ground").enabled = false;
-    s.settings.solver.sleep_speed = 0.0f;
-    s.material.enabled = true;
-    s.material.density = 0.15f;
-    s.material.stretch = {400.0f, 200.0f};
-    s.material.shear = 20.0f;
-    s.material.bending = glm::vec2(1e-6f);
-    s.material.stretch_curve = curve;
-    s.material.explicit_fields |= kMaterialStretchCurve;
-    derive_springs(s);
-    MassSpring sim = build_simulation(s);
-    for (int i = 0; i < per_side; ++i) {
-        const std::size_t p = along_u ? static_cast<std::size_t>(i) * per_side + per_side - 1
-                                      : static_cast<std::size_t>(per_side - 1) * per_side + i;
-        sim.set_pinned(p, true);
-        glm::vec3 x = sim.position(p);
-        (along_u ? x.x : x.y) *= static_cast<float>(1.0 + strain);
-        sim.move_pinned(p, x);
-    }
-    // The slowest in-plane mode at the steepest tangent, damped at critical and settled to e^-20.
+    MaterialSettings m;
+    m.density = 0.15f;
+    m.stretch = {400.0f, 200.0f};
+    m.shear = 20.0f;
+    m.bending = glm::vec2(1e-6f);
+    m.stretch_curve = curve;
+    m.explicit_fields |= kMaterialStretchCurve;
     double steepest = 1.0;
     for (const auto* samples : {&curve.u, &curve.v}) {
         for (const StretchSample& x : *samples) steepest = std::max(steepest, double(x.factor));
     }
-    const double w = 3.14159 * std::sqrt(200.0 * steepest / 0.15) / side;
-    SimulationSettings settings = sim.settings();
-    settings.springs.damping = static_cast<float>(2.0 * w);
-    sim.apply(settings);
-    sim.set_substeps(auto_substeps(stability_limit(sim), settings.integration.dt, 0.5f, 1));
-    sim.run_steps(static_cast<long long>(std::ceil(20.0 / w / settings.integration.dt)));
-    return sim.energy().spring_potential / (side * side);
+    const MassSpring sim = test::pulled_sheet(per_side, along_u, m, strain, 200.0 * steepest, 0.5f);
+    return sim.energy().spring_potential / (0.3 * 0.3);
 }
 
 // The energy per area of a tensile test of stretch S with the factors `samples`: the integral of the tension.

@@ -83,7 +83,7 @@ inline constexpr std::array<std::string_view, 4> kFirstFormSections = {"sphere",
 Collider& first_form_collider(ColliderSettings& colliders, std::string_view section);
 
 // ---- Names of the enumerations, as written in files. ----
-std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge
+std::span<const std::string_view> pin_preset_names();   // none, top-corners, top-row, four-corners, left-edge, center
 std::span<const std::string_view> clip_kind_names();    // rigid, soft
 std::span<const std::string_view> wind_model_names();   // triangles, uniform
 std::span<const std::string_view> solver_method_names(); // fast, textbook

@@ -19,8 +19,10 @@
 
 namespace clothsim {
 
-// Named sets of pinned particles (row 0 is the edge the cloth's origin lies on).
-enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge };
+// Named sets of pinned particles (row 0 is the edge the cloth's origin lies on). Center: the middle particle
+// ((rows - 1) / 2, (cols - 1) / 2), with the preset's radius a clip that stays centred at any resolution (the
+// Cusick test's clamp).
+enum class PinPreset { None, TopCorners, TopRow, FourCorners, LeftEdge, Center };
 // The kind of clip (a pin with a radius; Pin): Rigid pins every particle within the radius; Soft holds each to
 // where it is at rest by a zero-length spring whose stiffness fades to 0 at the rim (docs/MATERIAL.md,
 // "Soft clips"): the load enters the cloth smoothly, and a cloth held in the plane it hangs in has a largest

@@ -690,7 +690,23 @@ TEST_CASE("scene pins: pinned_particles of every preset on a 4 x 5 grid") {
     CHECK(pins(clothsim::PinPreset::TopRow) == V{0, 1, 2, 3, 4});
     CHECK(pins(clothsim::PinPreset::FourCorners) == V{0, 4, 15, 19});
     CHECK(pins(clothsim::PinPreset::LeftEdge) == V{0, 5, 10, 15});
-    REQUIRE(clothsim::pin_preset_names().size() == 5);
+    CHECK(pins(clothsim::PinPreset::Center) == V{7});  // row 1, column 2: (rows - 1) / 2, (cols - 1) / 2
+    REQUIRE(clothsim::pin_preset_names().size() == 6);
+    // With a radius, the centre's clip stays centred as the grid is refined (the Cusick clamp): its particles'
+    // mean rest position is the cloth's centre, and it holds the same area of cloth, at 41, 61 and 81 a side.
+    for (int n : {41, 61, 81}) {
+        clothsim::ClothSettings disc;
+        disc.rows = disc.cols = n;
+        disc.size = {0.3f, 0.3f};
+        const V held = clothsim::pinned_particles(disc, {clothsim::PinPreset::Center, {}, 0.09f});
+        double sum_r = 0.0, sum_c = 0.0;
+        for (std::size_t i : held) sum_r += double(i / n), sum_c += double(i % n);
+        INFO(n << " a side: " << held.size() << " particles held");
+        CHECK(sum_r / double(held.size()) == Approx((n - 1) / 2.0));
+        CHECK(sum_c / double(held.size()) == Approx((n - 1) / 2.0));
+        const double h = 0.3 / (n - 1), area = double(held.size()) * h * h;
+        CHECK(area == Approx(3.14159265 * 0.09 * 0.09).epsilon(0.05));
+    }
 
     // Explicit particles are added to the preset, row-major, sorted, without duplicates.
     CHECK(clothsim::pinned_particles(cloth, {clothsim::PinPreset::TopCorners, {{3, 2}, {0, 4}, {1, 0}}}) ==

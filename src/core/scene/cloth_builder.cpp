@@ -180,6 +180,7 @@ void for_each_pinned(const ClothSettings& cloth, const PinSpec& pins, Visit&& vi
             pin(0, 0, clip); pin(0, cols - 1, clip); pin(rows - 1, 0, clip); pin(rows - 1, cols - 1, clip);
             break;
         case PinPreset::LeftEdge: for (int r = 0; r < rows; ++r) pin(r, 0, clip); break;
+        case PinPreset::Center: pin((rows - 1) / 2, (cols - 1) / 2, clip); break;
     }
     // A grid's vertices are its particles, row-major.
     for (const Pin& p : pins.particles) {

@@ -89,8 +89,8 @@ const std::array kFields = {
 };
 // clang-format on
 
-constexpr std::array<std::string_view, 5> kPinPresetNames = {"none", "top-corners", "top-row", "four-corners",
-                                                             "left-edge"};
+constexpr std::array<std::string_view, 6> kPinPresetNames = {"none",         "top-corners", "top-row", "four-corners",
+                                                             "left-edge",    "center"};
 constexpr std::array<std::string_view, 2> kClipKindNames = {"rigid", "soft"};
 constexpr std::array<std::string_view, 2> kWindModelNames = {"triangles", "uniform"};
 constexpr std::array<std::string_view, 2> kSolverMethodNames = {"fast", "textbook"};

@@ -103,8 +103,9 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
             const double strain = glm::length(state.position.get(s.b) - state.position.get(s.a)) / s.rest_length - 1.0;
             worst = curve.steepest();
             steepest_tangent = std::max(steepest_tangent, worst);
-            at_strain[s.a] += 2.0 * k * (curve.tangent(strain) - worst);
-            at_strain[s.b] += 2.0 * k * (curve.tangent(strain) - worst);
+            const double lost = 2.0 * k * (curve.tangent(strain) - worst);
+            at_strain[s.a] += lost;
+            at_strain[s.b] += lost;
         }
         row_sum[s.a] += 2.0 * k * worst;
         row_sum[s.b] += 2.0 * k * worst;

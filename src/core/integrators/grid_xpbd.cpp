@@ -715,6 +715,8 @@ double GridXpbd::residual(const DVec3Array& position) const {
         if (!present_[d]) continue;
         const int offset = kDirections[d].dr * cols_ + kDirections[d].dc;
         const bool bend = d >= 4 && bends_;
+        static const SpringCurve kLinear{};
+        const SpringCurve& curve = d < 2 ? curve_[d] : kLinear;
         for (std::size_t e = 0; e < n; ++e) {
             if (!(k_[d][e] > 0.0f)) continue;
             const double k = k_[d][e];
@@ -728,9 +730,7 @@ double GridXpbd::residual(const DVec3Array& position) const {
                 residual2 += glm::dot(r, r);
             } else {
                 const double c = glm::length(position.get(i + offset) - position.get(i)) - rest_[d][e];
-                const SpringCurve& curve = d < 2 ? curve_[d] : SpringCurve{};
-                const double r = curve.knots == 0 ? c + lambda_[d][e] / (k * h2)
-                                                  : c + lambda_[d][e] * curved_compliance(1.0 / (k * h2), curve, c, rest_[d][e]);
+                const double r = spring_residual(c, lambda_[d][e], k, h2, curve, rest_[d][e]);
                 residual2 += r * r;
             }
         }

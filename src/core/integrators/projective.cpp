@@ -271,11 +271,7 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
             const double length = glm::length(d);
             const double stretch = length - s.rest_length;
             const SpringCurve& curve = curve_of(springs, s);
-            if (curve.knots == 0) {
-                e += 0.5 * k * stretch * stretch;
-            } else {
-                e += k * curve.energy_term(stretch, s.rest_length);
-            }
+            e += spring_energy(k, curve, stretch, s.rest_length);
             if (s.rest_length == 0.0f || !(length > 1e-12)) continue;
             // A curved spring's target length is |d| - t(|d| - L0) instead of L0, so that k (d - d_s) is its
             // force: the constant matrix with the true gradient (Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods

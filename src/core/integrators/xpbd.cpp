@@ -67,9 +67,7 @@ double xpbd_residual(const DVec3Array& position, const Topology& topology, const
         const double k = stiffness_of(springs, s);
         if (k == 0.0) continue;
         const double c = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
-        const SpringCurve& curve = curve_of(springs, s);
-        const double r = curve.knots == 0 ? c + multipliers.spring[j] / (k * h2)
-                                          : c + multipliers.spring[j] * curved_compliance(1.0 / (k * h2), curve, c, s.rest_length);
+        const double r = spring_residual(c, multipliers.spring[j], k, h2, curve_of(springs, s), s.rest_length);
         residual2 += r * r;
     }
     for (std::size_t j = 0; j < topology.bends.size(); ++j) {

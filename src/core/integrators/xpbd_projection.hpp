@@ -26,6 +26,14 @@ inline double curved_compliance(double alpha, const SpringCurve& curve, double c
     return alpha * (c / curve.stretch_term(c, rest_length));
 }
 
+// A spring's residual C + alpha~ lambda (Macklin, Mueller & Chentanez 2016, eq. 9) with alpha~ = 1 / (k h^2),
+// a curved spring's at its secant compliance.
+inline double spring_residual(double c, double lambda, double k, double h2, const SpringCurve& curve,
+                              double rest_length) {
+    return curve.knots == 0 ? c + lambda / (k * h2)
+                            : c + lambda * curved_compliance(1.0 / (k * h2), curve, c, rest_length);
+}
+
 inline double project_spring(State& state, std::size_t a, std::size_t b, double rest_length, double alpha,
                              double& lambda, const SpringCurve* curve = nullptr) {
     const double wa = state.inverse_mass[a], wb = state.inverse_mass[b];

@@ -108,8 +108,7 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
     for (const Spring& s : topology.springs) {
         const double k = stiffness_of(springs, s);
         const double stretch = glm::length(position.get(s.b) - position.get(s.a)) - s.rest_length;
-        const SpringCurve& curve = curve_of(springs, s);
-        energy += curve.knots == 0 ? 0.5 * k * stretch * stretch : k * curve.energy_term(stretch, s.rest_length);
+        energy += spring_energy(k, curve_of(springs, s), stretch, s.rest_length);
     }
     for (const Bend& b : topology.bends) {
         const glm::dvec3 d = bend_difference(position, b);

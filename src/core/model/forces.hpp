@@ -67,6 +67,11 @@ inline const SpringCurve& curve_of(const SpringSettings& springs, SpringKind kin
 inline const SpringCurve& curve_of(const SpringSettings& springs, const Spring& s) {
     return curve_of(springs, s.kind, s.axis);
 }
+// A spring's elastic energy (J) at `stretch` = |d| - L0, for its k w: 0.5 k w stretch^2, or with a stretch curve
+// k w times the curve's energy_term.
+inline double spring_energy(double k, const SpringCurve& curve, double stretch, double rest) {
+    return curve.knots == 0 ? 0.5 * k * stretch * stretch : k * curve.energy_term(stretch, rest);
+}
 inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
     return stiffness_of(springs, SpringKind::Bending, b.axis) * b.weight;
 }

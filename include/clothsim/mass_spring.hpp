@@ -161,6 +161,13 @@ public:
     // Stops every particle where it is: zero velocity, positions unchanged (a settle's kinetic damping,
     // settle.hpp). A multistep integrator starts afresh.
     void stop();
+    // 1/s of velocity damping added to springs.damping: a settle's own viscous damping once its fall is over
+    // (settle.hpp), not a scene setting (the panel and the scene file never see it); 0 unless a settle runs.
+    // Throws std::invalid_argument for a negative or non-finite rate.
+    void set_settle_damping(double rate);
+    double settle_damping() const { return settle_damping_; }
+    // 1/s: the damping rate c in x'' = a - c x' that every integrator uses, springs.damping plus the settle's.
+    double damping_rate() const { return settings_.springs.damping + settle_damping_; }
     // Changes whenever positions may have changed (a step, a pin moved, a rebuild); equal stamps mean equal
     // positions, even across copies (a rollback), so a renderer can skip normals and uploads.
     std::uint64_t change_stamp() const { return stamp_; }
@@ -305,6 +312,7 @@ private:
     State state_;
     SimulationSettings settings_;
     std::uint64_t history_stamp_ = 0;  // stamp_ as the last substep left it; 0 after a restart
+    double settle_damping_ = 0.0;      // 1/s, set_settle_damping
     std::size_t broken_springs_ = 0;
     std::uint64_t topology_stamp_ = 0;
     ClothSurface surface_;       // follows topology_ (topology_changed)

@@ -83,7 +83,7 @@ void record_energy(AppState& app) {
 
 // What a new cloth resets: the grab, the time owed, the plots, the renderer's buffers.
 void after_rebuild(AppState& app, Renderer& renderer) {
-    app.settling.reset();
+    app.stop_settling();
     app.grab.reset();
     app.object_drag.reset();
     app.stepper.restart();
@@ -163,7 +163,7 @@ StepReport settle_frame(AppState& app, bool one_step_a_frame) {
         total.guard_gave_up = r.guard_gave_up;
         if (r.steps == 0 || r.guard_gave_up || r.skipped_non_finite) {
             app.say("settle stopped: the cloth did not step", true);
-            app.settling.reset();
+            app.stop_settling();
             break;
         }
         if (app.settling->after_step(app.sim)) {
@@ -174,7 +174,7 @@ StepReport settle_frame(AppState& app, bool one_step_a_frame) {
             app.say(text);
             std::printf("clothsim: %s\n", text);  // and on the terminal, as a finished long job
             std::fflush(stdout);
-            app.settling.reset();
+            app.stop_settling();
             break;
         }
         if (one_step_a_frame || std::chrono::duration<double>(Clock::now() - start).count() >= kSettleFrameSeconds) break;

@@ -195,6 +195,11 @@ struct AppState {
     // The scene as it runs: the document with the simulation's live settings (what Save writes).
     Scene document() const { return running_scene(scene, sim); }
 
+    // Ends a settle, settled or not: the cloth goes on with the scene's own damping.
+    void stop_settling() {
+        settling.reset();
+        sim.set_settle_damping(0.0);
+    }
     // A message in the panel's message area; an error, or a warning (`to_stderr`), also goes to stderr.
     void say(std::string message, bool error = false, bool to_stderr = false) {
         if (messages.add(message, error) && (error || to_stderr)) {

@@ -299,6 +299,8 @@ void print_json(const Scene& scene, const MassSpring& sim, const RunOutcome& run
             {"particle", settler->residual().particle},
             {"tolerance", settler->options().tolerance},
             {"velocity_resets", settler->resets()},
+            {"damped_from", settler->damping() ? nlohmann::json(settler->damping_since()) : nlohmann::json(nullptr)},
+            {"damping_rate", settler->damping_rate()},
         };
     }
     // A disc (a grid's, or a mesh cloth) on the cylinder is a Cusick drape test (drape.hpp): its coefficient and
@@ -325,9 +327,13 @@ void print_text(const Scene& scene, const MassSpring& sim, const RunOutcome& run
                 e.potential(), e.total(), run.finite ? "yes" : "no", run.blew_up() ? "yes (" : "no",
                 run.cause(), run.blew_up() ? ")" : "");
     if (settler) {
-        std::printf("%s after %.4g simulated s: residual %.3g (tolerance %.3g) at particle %zu, %d velocity resets\n",
+        std::printf("%s after %.4g simulated s: residual %.3g (tolerance %.3g) at particle %zu, %d velocity resets",
                     settler->settled() ? "settled" : "not settled", sim.time(), settler->residual().value,
                     settler->options().tolerance, settler->residual().particle, settler->resets());
+        if (settler->damping()) {
+            std::printf(", damped from t = %.4g s (last at %.3g/s)", settler->damping_since(), settler->damping_rate());
+        }
+        std::printf("\n");
     }
     print_profile(sim.profile(), describe(sim.plan(), sim.topology(), sim.settings()), run.steps, sim.asleep());
 }

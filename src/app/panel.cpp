@@ -653,19 +653,20 @@ void scene_section(AppState& app, PanelRequests& requests) {
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("back to the scene as loaded or last saved, dropping every edit");
     ImGui::SameLine();
     if (ImGui::Button(app.settling ? "Stop settling" : "Settle")) {
-        if (app.settling) app.settling.reset();
+        if (app.settling) app.stop_settling();
         else app.settling.emplace();
     }
     if (ImGui::IsItemHovered()) {
         ImGui::SetTooltip("runs the cloth to rest as fast as it can: the dynamics with every velocity zeroed past each "
-                          "peak of the kinetic energy (kinetic damping), until the largest net force on a particle is "
-                          "under 1%% of its weight (docs/MATERIAL.md)");
+                          "peak of the kinetic energy (kinetic damping), and a damping of its own once the fall is over, "
+                          "until the largest net force on a particle is under 1%% of its weight (docs/MATERIAL.md)");
     }
     if (app.settling) {
         const Residual& r = app.settling->residual();
         if (std::isfinite(r.value)) {
-            ImGui::Text("settling: residual %.3g (to %.3g), %d resets, t = %.2f s", r.value, app.settling->options().tolerance,
-                        app.settling->resets(), app.sim.time());
+            ImGui::Text("settling: residual %.3g (to %.3g), %d resets%s, t = %.2f s", r.value,
+                        app.settling->options().tolerance, app.settling->resets(),
+                        app.settling->damping() ? ", damped" : "", app.sim.time());
         } else {
             ImGui::Text("settling: t = %.2f s", app.sim.time());
         }

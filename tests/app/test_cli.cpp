@@ -912,6 +912,9 @@ TEST_CASE("cli: --settle runs until the residual falls below the tolerance and r
     CHECK(settle.at("residual").get<double>() < 0.01);
     CHECK(settle.at("tolerance").get<double>() == 0.01);
     CHECK(settle.at("velocity_resets").get<int>() > 0);
+    // The settle's own damping went on after the fall, before it settled.
+    CHECK(settle.at("damped_from").get<double>() > 0.0);
+    CHECK(settle.at("damped_from").get<double>() < out.at("simulated_seconds").get<double>());
     // It stops once settled, before the 30 s limit.
     CHECK(out.at("simulated_seconds").get<double>() < 29.0);
     // A looser tolerance settles sooner.

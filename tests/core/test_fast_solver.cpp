@@ -350,7 +350,7 @@ TEST_CASE("fast solver: the motion bounds its sweep takes leave NaN motions out,
                 state.position.x[row * 40 + 39] = NAN;
             }
             MotionBounds b;
-            solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, &b);
+            solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), scene.settings.springs.damping, nullptr, &b);
             MotionBounds pass;
             include_motion(state.motion, 0, state.size(), pass);
             INFO(FastSolver::kernel_name() << ", " << threads << " thread(s)");
@@ -384,9 +384,9 @@ TEST_CASE("fast solver: the motion bounds its sweep takes are those of every par
                 for (int substep = 0; substep < 6; ++substep) {
                     const Vec3Array* ext = substep % 2 ? &external : nullptr;
                     State plain = state;  // the same substep without the bounds
-                    solver.step(plain, scene.settings, 7u, ext, sim.substep_length(), nullptr, nullptr);
+                    solver.step(plain, scene.settings, 7u, ext, sim.substep_length(), scene.settings.springs.damping, nullptr, nullptr);
                     MotionBounds b;
-                    solver.step(state, scene.settings, 7u, ext, sim.substep_length(), nullptr, &b);
+                    solver.step(state, scene.settings, 7u, ext, sim.substep_length(), scene.settings.springs.damping, nullptr, &b);
                     INFO(name << " " << cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
                               << " thread(s), substep " << substep);
                     CHECK(state.position == plain.position);
@@ -430,11 +430,11 @@ TEST_CASE("fast solver: the block boxes its sweep leaves are particle_bounds of 
                 for (int substep = 0; substep < 4; ++substep) {
                     const bool motion = substep % 2 == 1;  // the row update with and without the motion's bounds
                     State plain = state;
-                    solver.step(plain, scene.settings, 7u, nullptr, sim.substep_length(), nullptr, nullptr);
+                    solver.step(plain, scene.settings, 7u, nullptr, sim.substep_length(), scene.settings.springs.damping, nullptr, nullptr);
                     // Boxes the sweep must overwrite, as the collision stage's vector is reused between substeps.
                     std::vector<Box> boxes(start.size() - 1, Box{glm::vec3(1e30f), glm::vec3(1e30f)});
                     MotionBounds bounds;
-                    solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), &boxes,
+                    solver.step(state, scene.settings, 7u, nullptr, sim.substep_length(), scene.settings.springs.damping, &boxes,
                                  motion ? &bounds : nullptr);
                     INFO(cols << " x " << cols << ", " << FastSolver::kernel_name() << ", " << threads
                               << " thread(s), substep " << substep);

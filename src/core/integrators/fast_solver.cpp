@@ -476,7 +476,7 @@ int FastSolver::band_count(int threads) const {
 }
 
 void FastSolver::step(State& state, const SimulationSettings& settings, unsigned kinds, const Vec3Array* external,
-                      double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds,
+                      double h, double damping, std::vector<Box>* row_boxes, MotionBounds* motion_bounds, BlockBounds bounds,
                       Box* band_unions) {
     const unsigned spring_mask = (kinds & 7u) | (bends_ ? kBendsBit : 0u);
     const int threads = effective_threads(settings.solver.threads);
@@ -499,7 +499,7 @@ void FastSolver::step(State& state, const SimulationSettings& settings, unsigned
         team_.reset();
     }
     if (row_boxes) row_boxes->resize(static_cast<std::size_t>(rows_) * blocks_per_row(cols_));
-    const SweepSettings sweep_settings{settings, spring_mask, external, h, row_boxes ? row_boxes->data() : nullptr,
+    const SweepSettings sweep_settings{settings, spring_mask, external, h, damping, row_boxes ? row_boxes->data() : nullptr,
                                        bounds, motion_bounds != nullptr};
     // With solver.threads = 0 the team may be set aside for this substep (team_choice.hpp).
     const bool automatic = settings.solver.threads == 0 && threads > 1;
@@ -795,6 +795,7 @@ struct SweepInput {
     const SimulationSettings& settings;
     const Vec3Array* external;
     double h;
+    double damping;
     Box* row_boxes;  // the boxes of each row's blocks after its update (block_starts), or null
     BlockBounds bounds;  // what of each box
     float* window;
@@ -807,7 +808,7 @@ template <FastKernel K, unsigned Mask>
     const Grid& grid = in.grid;
     const std::size_t stride = grid.stride();
     const std::size_t row_floats = grid.row_floats();
-    const auto [keep, h2] = verlet_coefficients(in.settings.springs.damping, in.h);
+    const auto [keep, h2] = verlet_coefficients(in.damping, in.h);
     const glm::vec3 g = in.settings.forces.gravity;
     // The spring rows r, r-1, r-2: in the rolling window, in the shared boundary storage, or zero above row 0.
     const float* spring_rows[3] = {in.zeros, in.zeros, in.zeros};
@@ -916,7 +917,7 @@ void FastSolver::spring_row(const State& state, const SpringSettings& springs, u
 void FastSolver::sweep(State& state, const SweepSettings& sweep, int begin, int end, Scratch& scratch,
                        const std::vector<int>& boundary_slot) {
     const Grid grid{rows_, cols_, rest_, present_, row_weight_, fix_begin_, fixes_};
-    const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h,
+    const SweepInput in{grid, boundary_, boundary_slot, sweep.settings, sweep.external, sweep.h, sweep.damping,
                         sweep.row_boxes, sweep.bounds, scratch.window.data(), zeros_.data(),
                         sweep.motion_bounds ? scratch.motion_lanes.data() : nullptr};
     sweep_table(kernel_in_use(), std::make_index_sequence<16>())[sweep.mask & 15u](in, state, begin, end);

@@ -55,7 +55,7 @@ public:
     // `row_boxes`, `band_unions` (when not null, kMaxBands entries) receives the union of each band's boxes,
     // made on the band's thread, the rest empty: the cloth's box without reading every block's box again.
     void step(State& state, const SimulationSettings& settings, unsigned spring_mask, const Vec3Array* external,
-              double h, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
+              double h, double damping, std::vector<Box>* row_boxes, MotionBounds* motion_bounds = nullptr,
               BlockBounds bounds = BlockBounds::Box, Box* band_unions = nullptr);
 
     // Threads the solver will really use for `requested` (0 = one per core): at most one per 8 rows.
@@ -94,6 +94,7 @@ private:
         unsigned mask;
         const Vec3Array* external;
         double h;
+        double damping;  // 1/s: MassSpring::damping_rate()
         Box* row_boxes;
         BlockBounds bounds;
         bool motion_bounds;

@@ -413,7 +413,7 @@ void projective_substep(IntegratorContext& c) {
     ProjectiveSolver::Inputs inputs;
     inputs.external = &external;
     inputs.gravity = c.settings.forces.gravity;
-    inputs.damping = c.settings.springs.damping;
+    inputs.damping = c.dynamics.damping;
     inputs.iterations = c.settings.integration.iterations;
     inputs.tolerance = c.settings.integration.tolerance;
     c.solve = c.caches.projective.step(c.state, c.topology, c.settings.springs, inputs, c.h, c.continues);

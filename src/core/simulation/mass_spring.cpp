@@ -374,7 +374,8 @@ void MassSpring::step_fast(double h, StepProfile* profile) {
     {
         StageTimer timer(profile, Stage::Fast);
         static_assert(CollisionBlocks::kBandUnions == FastSolver::kMaxBands);
-        in_->fast->step(state_, settings_, plan_.spring_mask(), external, h, boxes ? &in_->blocks.boxes : nullptr,
+        in_->fast->step(state_, settings_, plan_.spring_mask(), external, h, damping_rate(),
+                        boxes ? &in_->blocks.boxes : nullptr,
                         sweep_takes_motion_bounds() ? &in_->motion_bounds : nullptr, in_->blocks.bounds,
                         boxes ? in_->blocks.band_union.data() : nullptr);
     }
@@ -401,11 +402,11 @@ void MassSpring::step_textbook(double h, StepProfile* profile) {
         StageTimer timer(profile, Stage::Integrate);
         if (const int threads = mesh_team_threads(); threads > 0) {
             WorkTeam::shared().run_pieces(threads, state_.size(), kTeamPiece, [&](std::size_t first, std::size_t last) {
-                integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h, first, last);
+                integrate_verlet(state_, force_, settings_.forces.gravity, damping_rate(), h, first, last);
             });
             state_.substep = h;
         } else {
-            integrate_verlet(state_, force_, settings_.forces.gravity, settings_.springs.damping, h);
+            integrate_verlet(state_, force_, settings_.forces.gravity, damping_rate(), h);
         }
     }
 }
@@ -582,6 +583,11 @@ void MassSpring::stop() {
     restart(std::vector<glm::dvec3>(state_.size(), glm::dvec3(0.0)), substep_length());
 }
 
+void MassSpring::set_settle_damping(double rate) {
+    if (!(rate >= 0.0) || !std::isfinite(rate)) throw std::invalid_argument("settle damping must be finite and >= 0");
+    settle_damping_ = rate;
+}
+
 // Provot (1995): after the step, a spring longer than (1 + limit) L0 is shortened to that length, its ends
 // moving in proportion to their inverse masses (one Gauss-Seidel pass, spring-list order). The correction
 // adds no velocity of its own (like a collision push), and the ends' motion apart along the spring is
@@ -640,7 +646,7 @@ void MassSpring::step_velocity_integrator(Integrator integrator, double h, bool 
         }
         if (in_->grab) f.add(in_->grab->particle, grab_force(s));
     };
-    const Dynamics dynamics{forces, external, settings_.forces.gravity, settings_.springs.damping};
+    const Dynamics dynamics{forces, external, settings_.forces.gravity, static_cast<float>(damping_rate())};
     IntegratorContext context{state_, topology_, settings_, dynamics, h, continues, in_->iterative, {}, {}};
     context.frozen_external = [this](Vec3Array& f) {
         f.resize(state_.size());
@@ -744,7 +750,7 @@ void MassSpring::restart(const std::vector<glm::dvec3>& velocity, double h) {
     state_.integrator = integrator;
     if (!integrator_info(integrator).keeps_velocity) {  // Verlet: motion = x - x_prev
         compute_forces(state_, force_);
-        start_verlet(state_, velocity, force_, settings_.forces.gravity, settings_.springs.damping, h);
+        start_verlet(state_, velocity, force_, settings_.forces.gravity, damping_rate(), h);
         return;
     }
     // The velocity integrators keep motion = v h.
@@ -786,7 +792,7 @@ std::vector<glm::dvec3> MassSpring::velocities_in_double() const {
     }
     Vec3Array force;
     compute_forces(state_, force);
-    return verlet_velocities(state_, force, settings_.forces.gravity, settings_.springs.damping);
+    return verlet_velocities(state_, force, settings_.forces.gravity, damping_rate());
 }
 
 Energy MassSpring::energy() const {

@@ -110,6 +110,9 @@ struct SpringSettings {
     // The structural springs' stretch curves along u_axis, along v_axis (stretch_curve.hpp): no knots = linear.
     // Derived from material.stretch_curve on a grid cloth.
     std::array<SpringCurve, 2> stretch_curve{};
+    // A mesh cloth's material springs' curves by warp level (Spring::warp_level - 1; stretch_curve.hpp: blends of
+    // both directions). Derived from material.stretch_curve on a mesh cloth.
+    std::array<SpringCurve, kWarpLevels + 1> mesh_curve{};
     bool operator==(const SpringSettings&) const = default;
 };
 

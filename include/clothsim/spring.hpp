@@ -29,6 +29,10 @@ struct Spring {
     float rest_length = 0.0f;  // m
     SpringKind kind = SpringKind::Structural;
     Axis axis = Axis::U;
+    // A mesh cloth's material spring: 1 + cos^2 of its rest direction's angle to u_axis in kWarpLevels-ths
+    // (rounded), which picks its stretch curve, a blend of the two directions' (SpringSettings::mesh_curve,
+    // stretch_curve.hpp); 0 on a grid and in the per-spring form, whose structural springs take their axis's.
+    std::uint8_t warp_level = 0;
     // The share of the cells around the spring the cloth has: 1 inside, 0.5 for a structural spring on the
     // cloth's edge, which borders one cell instead of two (material form; always 1 in the per-spring form).
     // A power of two, so k w is exact and every solver path rounds alike.

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,20 @@ struct SpringCurve {
         return u;
     }
 };
+
+// A mesh cloth's edge spring (cloth_mesh.hpp) is as stiff as E_u c + E_v (1 - c) times its geometry, for
+// c = cos^2 of its rest direction's angle to u_axis: each direction's part follows that direction's curve, so
+// its stretch term is alpha T_u(e) + (1 - alpha) T_v(e) with alpha = E_u c / (E_u c + E_v (1 - c)), the warp's
+// share of its stiffness. The springs carry the whole membrane there (van Gelder), so each direction's gains are
+// m_j - m_(j-1). c is rounded to kWarpLevels-ths (Spring::warp_level), one blend per level.
+inline constexpr int kWarpLevels = 32;
+// That blend as one hinge sum: both curves' knots, gains alpha r_u and (1 - alpha) r_v, merged where the strains
+// are equal (Wang et al.'s samples share theirs). Empty when the knots do not fit kMaxStretchSamples.
+std::optional<SpringCurve> blended_curve(const SpringCurve& u, const SpringCurve& v, double alpha);
+// "" when a mesh cloth can take the curve: at most kMaxStretchSamples distinct strains in u and v together.
+std::string mesh_curve_problem(const StretchCurve& curve);
+// A mesh cloth's curves, one per warp level (level L blends at c = L / kWarpLevels), for `stretch` = E_u, E_v.
+std::array<SpringCurve, kWarpLevels + 1> mesh_curves(const StretchCurve& curve, double stretch_u, double stretch_v);
 
 // A material direction's samples as a spring's curve: the spring's linear stiffness carries `linear` of the
 // membrane's tangent `stretch` (N/m; the rest comes from the diagonals), so a tangent factor m adds

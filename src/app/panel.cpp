@@ -435,7 +435,7 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
                           "per spring and a material rebuilds the cloth");
     }
     if (result != FabricEdit::None) return result;
-    if (edit.material.enabled && !app.sim.topology().mesh) {
+    if (edit.material.enabled) {
         // The stretch curve on the fabric's own row (SameLine: nothing below moves): linear or the preset's
         // measured curve (docs/MATERIAL.md, "Nonlinear stretch").
         ImGui::SameLine();

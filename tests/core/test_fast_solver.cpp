@@ -211,7 +211,7 @@ TEST_CASE("fast solver is only used for grid topologies, others run the textbook
     // A missing spring is a slot of weight 0 (a disc's outline): still a grid.
     t.springs = {{0, 1, 1.0f, SpringKind::Structural}};
     CHECK(FastSolver::for_topology(t).has_value());
-    t.springs = {{0, 1, 1.0f, SpringKind::Structural, Axis::U, 0.3f}};  // a weight that is no power of two
+    t.springs = {{0, 1, 1.0f, SpringKind::Structural, Axis::U, 0, 0.3f}};  // a weight that is no power of two
     CHECK_FALSE(FastSolver::for_topology(t).has_value());
     t.springs.clear();
     t.bends = {{0, 2, 1, Axis::U, 1.0f}};  // a bend whose middle is not between its ends

@@ -278,9 +278,25 @@ TEST_CASE("stretch curve: the scene field loads, writes back, follows the preset
     CHECK_THAT(refusal("{ w = [[0.05, 2.0]] }"), Catch::Contains("unknown key 'w'"));
     CHECK_THAT(refusal("{ u = [[0.05]] }"), Catch::Contains("[strain, factor]"));
     CHECK_THAT(refusal("[1, 2]"), Catch::Contains("bad.toml"));
-    // A mesh cloth's edges mix warp and weft: a curve set on one is refused, a preset's is left out.
+    // A mesh cloth's edges mix warp and weft: its curves are blends by warp level (stretch_curve.hpp). Along u
+    // (the last level) the u curve with the whole membrane's gain, along v (the first) linear: the v part has no
+    // knot of its own, the u knot's gain is 0 there. More than 8 distinct strains in u and v together do not fit.
     Scene mesh = load_scene("skirt");
-    CHECK_THROWS_WITH(apply_override(mesh, "material.stretch_curve={ u = [[0.05, 2.0]] }"), Catch::Contains("mesh cloth"));
-    apply_override(mesh, "material.preset=gray-interlock");
-    CHECK(mesh.settings.springs.stretch_curve[0].knots == 0);
+    apply_override(mesh, "material.stretch_curve={ u = [[0.05, 2.0]] }");
+    const SpringSettings& springs = mesh.settings.springs;
+    CHECK(springs.stretch_curve[0].knots == 0);  // the grid's
+    REQUIRE(springs.mesh_curve[kWarpLevels].knots == 1);
+    CHECK(springs.mesh_curve[kWarpLevels].strain[0] == 0.05f);
+    CHECK(springs.mesh_curve[kWarpLevels].gain[0] == Approx(1.0));
+    CHECK(springs.mesh_curve[0].gain[0] == 0.0f);
+    const double e_u = mesh.material.stretch.x, e_v = mesh.material.stretch.y;
+    CHECK(springs.mesh_curve[kWarpLevels / 2].gain[0] == Approx(e_u / (e_u + e_v)));  // alpha at cos^2 = 1/2
+    CHECK_THROWS_WITH(apply_override(mesh, "material.stretch_curve={ u = [[0.01, 2], [0.02, 3], [0.03, 4], [0.04, 5], "
+                                           "[0.05, 6]], v = [[0.015, 2], [0.025, 3], [0.035, 4], [0.045, 5]] }"),
+                      Catch::Contains("at most 8 distinct strains") && Catch::Contains("has 9"));
+    // A Wang preset's curve on a mesh: its six strains are the same in u and v, one knot each.
+    Scene knit = load_scene("skirt");
+    apply_override(knit, "material.preset=gray-interlock");
+    CHECK(knit.settings.springs.mesh_curve[kWarpLevels / 2].knots == 6);
+    CHECK(has_mesh_curves(knit.settings.springs));
 }

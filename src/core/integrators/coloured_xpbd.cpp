@@ -73,8 +73,9 @@ inline double ColouredXpbd::spring_one(State& state, std::uint32_t e, XpbdMultip
     double& lambda = multipliers.spring[springs_.order[e]];
     lambda = 0.0;  // until projected (the step does not clear them)
     if (d.k[e] == 0.0) return 0.0;
+    const SpringCurve* curve = d.curve.empty() || d.curve[e].knots == 0 ? nullptr : &d.curve[e];
     return project_spring(state, static_cast<std::size_t>(d.a[e]), static_cast<std::size_t>(d.b[e]), d.rest[e],
-                          d.alpha[e], lambda);
+                          d.alpha[e], lambda, curve);
 }
 
 // One hinge of the colour pass, by project_hinge on its stored data.
@@ -247,6 +248,10 @@ std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology)
 void ColouredXpbd::set_stiffness(const Topology& topology, const SpringSettings& springs) {
     spring_data_.k.clear();
     for (std::uint32_t j : springs_.order) spring_data_.k.push_back(stiffness_of(springs, topology.springs[j]));
+    spring_data_.curve.clear();
+    if (has_mesh_curves(springs)) {
+        for (std::uint32_t j : springs_.order) spring_data_.curve.push_back(curve_of(springs, topology.springs[j]));
+    }
     hinge_data_.k.clear();
     for (std::uint32_t j : hinges_.order) hinge_data_.k.push_back(stiffness_of(springs, topology.hinges[j]));
     alpha_h_ = 0.0;
@@ -314,7 +319,7 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
         }
     };
     project(springs_, [&](std::uint32_t begin, std::uint32_t end) {
-        if (wide) return springs_avx512(state, begin, end, multipliers);
+        if (wide && spring_data_.curve.empty()) return springs_avx512(state, begin, end, multipliers);
         double v = 0.0;
         for (std::uint32_t e = begin; e < end; ++e) v += spring_one(state, e, multipliers);
         return v;

@@ -209,10 +209,11 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
     // Each element's force, as accumulate_spring_forces computes it (an element it skips gets zero, which adds
     // nothing: a sum that starts at +0 never becomes -0).
     const bool wide = FastSolver::kernel() == FastKernel::Avx512;
+    const bool curved = has_mesh_curves(springs);  // springs with curves in the scalar loop (its hinge sums)
     team.run(threads, spring_pieces + hinge_pieces, [&](int piece, int) {
         if (piece < spring_pieces) {
             const std::size_t first = static_cast<std::size_t>(piece) * kPiece, last = std::min(g.springs, first + kPiece);
-            if (wide) {
+            if (wide && !curved) {
                 springs_avx512(g, position, springs, first, last);
                 return;
             }
@@ -226,7 +227,7 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
                     if (rest == 0.0f) {
                         f = ks * d;
                     } else if (const float length = glm::length(d); length > 1e-12f) {
-                        f = (ks * (length - rest) / length) * d;
+                        f = (ks * curve_of(springs, s).stretch_term(length - rest, rest) / length) * d;
                     }
                 }
                 g.element_force.set(j, f);

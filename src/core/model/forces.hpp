@@ -1,6 +1,7 @@
 // Force stages of a time step. Each adds its contribution (N) to `force`; none clears it.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 
@@ -58,14 +59,20 @@ inline float stiffness_of(const SpringSettings& springs, SpringKind kind, Axis a
 inline float stiffness_of(const SpringSettings& springs, const Spring& s) {
     return stiffness_of(springs, s.kind, s.axis) * s.weight;
 }
-// A spring's stretch curve (stretch_curve.hpp): its axis's for a structural spring, none (linear) otherwise.
+// A spring's stretch curve (stretch_curve.hpp): its axis's for a grid's structural spring, its warp level's blend
+// for a mesh cloth's material spring, none (linear) otherwise.
 inline const SpringCurve& curve_of(const SpringSettings& springs, SpringKind kind, Axis axis) {
     static const SpringCurve kLinear{};
     if (kind != SpringKind::Structural || axis == Axis::Diagonal) return kLinear;
     return springs.stretch_curve[axis == Axis::V ? 1 : 0];
 }
 inline const SpringCurve& curve_of(const SpringSettings& springs, const Spring& s) {
+    if (s.warp_level != 0) return springs.mesh_curve[s.warp_level - 1];  // a mesh cloth's material spring
     return curve_of(springs, s.kind, s.axis);
+}
+// Whether a mesh cloth's springs have curves (the fast mesh paths then take their scalar order).
+inline bool has_mesh_curves(const SpringSettings& springs) {
+    return std::any_of(springs.mesh_curve.begin(), springs.mesh_curve.end(), [](const SpringCurve& c) { return c.knots > 0; });
 }
 // A spring's elastic energy (J) at `stretch` = |d| - L0, for its k w: 0.5 k w stretch^2, or with a stretch curve
 // k w times the curve's energy_term.

@@ -45,6 +45,46 @@ SpringCurve spring_curve(const std::vector<StretchSample>& samples, double stret
     return c;
 }
 
+std::optional<SpringCurve> blended_curve(const SpringCurve& u, const SpringCurve& v, double alpha) {
+    SpringCurve c;
+    std::uint32_t i = 0, j = 0;
+    while (i < u.knots || j < v.knots) {
+        // The next knot by strain; equal strains merge into one.
+        const bool take_u = i < u.knots && (j >= v.knots || u.strain[i] <= v.strain[j]);
+        const bool take_v = j < v.knots && (i >= u.knots || v.strain[j] <= u.strain[i]);
+        if (c.knots == static_cast<std::uint32_t>(kMaxStretchSamples)) return std::nullopt;
+        c.strain[c.knots] = take_u ? u.strain[i] : v.strain[j];
+        const double gain = (take_u ? alpha * double(u.gain[i++]) : 0.0) + (take_v ? (1.0 - alpha) * double(v.gain[j++]) : 0.0);
+        c.gain[c.knots++] = static_cast<float>(gain);
+    }
+    return c;
+}
+
+std::string mesh_curve_problem(const StretchCurve& curve) {
+    std::vector<float> strains;
+    for (const auto* samples : {&curve.u, &curve.v}) {
+        for (const StretchSample& s : *samples) strains.push_back(s.strain);
+    }
+    std::sort(strains.begin(), strains.end());
+    const auto distinct = std::unique(strains.begin(), strains.end()) - strains.begin();
+    if (distinct <= kMaxStretchSamples) return "";
+    return "a mesh cloth's springs mix u and v, so its curve takes at most " + std::to_string(kMaxStretchSamples) +
+           " distinct strains in u and v together (this one has " + std::to_string(distinct) + ")";
+}
+
+std::array<SpringCurve, kWarpLevels + 1> mesh_curves(const StretchCurve& curve, double stretch_u, double stretch_v) {
+    std::array<SpringCurve, kWarpLevels + 1> out{};
+    const SpringCurve u = spring_curve(curve.u, stretch_u, stretch_u), v = spring_curve(curve.v, stretch_v, stretch_v);
+    if (u.knots == 0 && v.knots == 0) return out;
+    for (int level = 0; level <= kWarpLevels; ++level) {
+        const double c = double(level) / kWarpLevels;
+        const double along_u = stretch_u * c, along_v = stretch_v * (1.0 - c);
+        const double alpha = along_u + along_v > 0.0 ? along_u / (along_u + along_v) : c;
+        out[static_cast<std::size_t>(level)] = blended_curve(u, v, alpha).value_or(SpringCurve{});
+    }
+    return out;
+}
+
 namespace {
 
 // ARCSim clamps each interpolated entry at 0 and doubles it; pulled along one direction with the other free,

@@ -29,7 +29,7 @@ Topology grid_topology(const ShapeMask& shape, const DVec3Array& position, bool 
         const auto b = static_cast<std::uint32_t>(t.index(r1, c1));
         // The rest length in the spring kernels' arithmetic (float d, float length), so a spring at its start
         // length exerts exactly no force.
-        t.springs.push_back({a, b, glm::length(glm::vec3(position.get(b) - position.get(a))), kind, axis, weight});
+        t.springs.push_back({a, b, glm::length(glm::vec3(position.get(b) - position.get(a))), kind, axis, 0, weight});
         ++t.spring_count_by_kind[static_cast<int>(kind)];
     };
     auto add_bend = [&](int r0, int c0, int dr, int dc, Axis axis, float weight) {

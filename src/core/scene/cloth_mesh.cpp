@@ -221,7 +221,8 @@ std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const 
         const double area = triangle_area(rest, triangles[e.triangle[0]]) + (e.count == 2 ? triangle_area(rest, triangles[e.triangle[1]]) : 0.0);
         const double k = area / length2 * (stretch.x * cu + stretch.y * (1.0 - cu));
         // The rest length in the spring kernels' arithmetic, as the grid's (cloth_builder.cpp); k = E_u w.
-        springs.push_back({e.a, e.b, glm::length(glm::vec3(d)), SpringKind::Structural, Axis::U,
+        const auto level = static_cast<std::uint8_t>(1 + std::lround(cu * kWarpLevels));
+        springs.push_back({e.a, e.b, glm::length(glm::vec3(d)), SpringKind::Structural, Axis::U, level,
                            static_cast<float>(k / stretch.x)});
     }
     return springs;
@@ -259,7 +260,7 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
         for (const EdgeUse& e : edges) {
             const glm::dvec3 d = rest[e.b] - rest[e.a];
             const float rest_length = glm::length(glm::vec3(d));
-            t.springs.push_back({e.a, e.b, rest_length, SpringKind::Structural, along_u(d) >= 0.5 ? Axis::U : Axis::V, 1.0f});
+            t.springs.push_back({e.a, e.b, rest_length, SpringKind::Structural, along_u(d) >= 0.5 ? Axis::U : Axis::V, 0, 1.0f});
         }
     }
     // Hinges on interior edges (Bergou et al. 2006): triangle 0 is (x0, x1, x2), triangle 1 (x0, x1, x3).

@@ -229,6 +229,7 @@ void note_field_set(Scene& scene, std::string_view field) {
         if (!m.enabled) {
             m = MaterialSettings{};
             scene.settings.springs.stretch_curve = {};  // the per-spring form is linear
+            scene.settings.springs.mesh_curve = {};
         }
         return;
     }
@@ -262,7 +263,9 @@ void derive_springs(Scene& scene) {
         s.structural = scene.material.stretch;
         s.shear = scene.material.shear;
         s.bending = scene.material.bending;
-        s.stretch_curve = {};  // a mesh cloth's edges mix warp and weft: linear (validate() refuses a curve set on one)
+        // Its edges mix warp and weft: a curve per warp level (stretch_curve.hpp, mesh_curves).
+        s.stretch_curve = {};
+        s.mesh_curve = mesh_curves(scene.material.stretch_curve, scene.material.stretch.x, scene.material.stretch.y);
         double area = 0.0;
         if (scene.cloth.mesh_data) {
             for (double a : vertex_areas(placed_cloth_vertices(scene.cloth), scene.cloth.mesh_data->triangles())) area += a;
@@ -280,6 +283,7 @@ void derive_springs(Scene& scene) {
     const glm::dvec2 h = grid_spacing(scene.cloth);
     s.stretch_curve = {spring_curve(scene.material.stretch_curve.u, scene.material.stretch.x, k.structural.x * h.x / h.y),
                        spring_curve(scene.material.stretch_curve.v, scene.material.stretch.y, k.structural.y * h.y / h.x)};
+    s.mesh_curve = {};
     scene.cloth.mass = static_cast<float>(k.total_mass);
 }
 

@@ -46,7 +46,7 @@ const std::array kFields = {
     FieldInfo{"material.density", "kg/m^2", 1e-3, 100, "areal density (mass per area)", [](Scene& s) -> FieldRef { return &s.material.density; }},
     FieldInfo{"material.stretch", "N/m", 1e-2, 1e7, "membrane tensile stiffness (force per width per strain): one number, or [warp along u_axis, weft along v_axis]", [](Scene& s) -> FieldRef { return &s.material.stretch; }},
     FieldInfo{"material.shear", "N/m", 0, 1e7, "in-plane shear stiffness (force per width per radian of shear)", [](Scene& s) -> FieldRef { return &s.material.shear; }},
-    FieldInfo{"material.stretch_curve", "", 0, 1e4, "nonlinear stretch of a grid cloth: { u = [[strain, factor], ...], v = [...] }, from each strain on (increasing, in (0, 1]) the tensile tangent stiffness is factor x material.stretch; {} = linear (Wang et al. presets carry their measured curves)", [](Scene& s) -> FieldRef { return &s.material.stretch_curve; }},
+    FieldInfo{"material.stretch_curve", "", 0, 1e4, "nonlinear stretch: { u = [[strain, factor], ...], v = [...] }, from each strain on (increasing, in (0, 1]) the tensile tangent stiffness is factor x material.stretch; {} = linear (Wang et al. presets carry their measured curves; on a mesh cloth at most 8 distinct strains in u and v together)", [](Scene& s) -> FieldRef { return &s.material.stretch_curve; }},
     FieldInfo{"material.bending", "N m", 0, 10, "flexural rigidity per unit width: one number, or [bending along u, along v]", [](Scene& s) -> FieldRef { return &s.material.bending; }},
 
     FieldInfo{"springs.structural", "N/m", 0, 1e9, "stiffness of each horizontal and vertical neighbour spring: one number, or [along u_axis, along v_axis] (derived from [material] when the scene has one)", [](Scene& s) -> FieldRef { return &s.settings.springs.structural; }},
@@ -318,9 +318,8 @@ void validate(const Scene& scene) {
                 throw SceneError(cat("material.stretch_curve.", axis, ": ", problem));
             }
         }
-        if (c.is_mesh() && (scene.material.explicit_fields & kMaterialStretchCurve) && !curve.empty()) {
-            throw SceneError("material.stretch_curve is set on a mesh cloth, whose edge springs mix warp and weft; "
-                             "allowed on a mesh cloth: {} (linear; docs/MATERIAL.md, \"Nonlinear stretch\")");
+        if (const std::string problem = c.is_mesh() ? mesh_curve_problem(curve) : ""; !problem.empty()) {
+            throw SceneError("material.stretch_curve: " + problem + " (docs/MATERIAL.md, \"Nonlinear stretch\")");
         }
     }
     const ColliderSettings& colliders = scene.settings.colliders;

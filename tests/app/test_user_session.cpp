@@ -776,8 +776,7 @@ TEST_CASE("user session: Settle brings the swinging hanging cloth to rest, says 
     const TempDir dir("session_settle");
     const RunResult r = run_user_session(
         dir, {"--scene", "hanging", "--set", "cloth.rows=16", "--set", "cloth.cols=16"},
-        "settle\nshot moving.png\nsettle\nsettle\nshot moved.png\n"
-        "click 349 105\nfor _ in $(seq 3000); do grep -q 'settled at' app.out && break; sleep 0.1; done\n"
+        "settle\nclick 349 105\nfor _ in $(seq 3000); do grep -q 'settled at' app.out && break; sleep 0.1; done\n"
         "settle\nshot settled.png\nsettle\nsettle\nshot later.png\nquit\n");
     CAPTURE_RUN(r);
     REQUIRE(r.code == 0);
@@ -787,24 +786,19 @@ TEST_CASE("user session: Settle brings the swinging hanging cloth to rest, says 
     const double residual = std::stod(r.out.substr(at + 9));
     CHECK(residual < 0.01);
     CHECK(residual >= 0.0);
-    // Settled, the cloth hangs still: the two screenshots' 3D views differ strongly in few pixels, where over the
-    // same frames before the Settle, the falling cloth moved across thousands. Its drift after the settle, a
-    // residual's worth (r g / omega^2: about 7 mm of the softest bulge at r = 0.009), shifts the texture's shading
-    // in a few hundred (measured 561 to 751 of the view's 600,000; the falling cloth 88,000).
-    const auto strongly_differing = [](const Image& first, const Image& second) {
-        REQUIRE(first.width == second.width);
-        long long differ = 0;
-        for (int y = 0; y < first.height; ++y) {
-            for (int x = 450; x < first.width; ++x) {
-                const Rgb a = first.at(x, y), b = second.at(x, y);
-                differ += std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b) > 60;
-            }
+    // Settled, the cloth hangs still: the two screenshots' 3D views differ strongly in few pixels. Its drift after
+    // the settle, a residual's worth (r g / omega^2: about 7 mm of the softest bulge at r = 0.009), shifts the
+    // texture's shading in a few hundred (measured 528 to 751 of the view's 600,000); the swinging cloth before
+    // the Settle, 4,800 to 88,000 over the same frames, depending on its phase and the machine's speed.
+    const Image settled = load_png(dir / "settled.png"), later = load_png(dir / "later.png");
+    REQUIRE(settled.width == later.width);
+    long long differ = 0;
+    for (int y = 0; y < settled.height; ++y) {
+        for (int x = 450; x < settled.width; ++x) {
+            const Rgb a = settled.at(x, y), b = later.at(x, y);
+            differ += std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b) > 60;
         }
-        return differ;
-    };
-    const long long moving = strongly_differing(load_png(dir / "moving.png"), load_png(dir / "moved.png"));
-    const long long differ = strongly_differing(load_png(dir / "settled.png"), load_png(dir / "later.png"));
-    INFO(moving << " pixels differ strongly before the settle, " << differ << " after it");
+    }
+    INFO(differ << " pixels differ strongly");
     CHECK(differ < 2000);
-    CHECK(moving > 10 * differ);
 }

@@ -249,7 +249,7 @@ void ColouredXpbd::set_stiffness(const Topology& topology, const SpringSettings&
     spring_data_.k.clear();
     for (std::uint32_t j : springs_.order) spring_data_.k.push_back(stiffness_of(springs, topology.springs[j]));
     spring_data_.curve.clear();
-    if (has_mesh_curves(springs)) {
+    if (has_curves(springs)) {  // curve_of: a grid's by axis, a mesh cloth's by warp level
         for (std::uint32_t j : springs_.order) spring_data_.curve.push_back(curve_of(springs, topology.springs[j]));
     }
     hinge_data_.k.clear();

@@ -72,7 +72,7 @@ private:
     struct SpringData {
         std::vector<std::int32_t> a, b;
         std::vector<double> rest, k, alpha;
-        std::vector<SpringCurve> curve;  // each spring's, when the cloth has curves (has_mesh_curves); else empty
+        std::vector<SpringCurve> curve;  // each spring's, when the cloth has curves (has_curves); else empty
     } spring_data_;
     struct HingeData {
         std::array<std::vector<std::int32_t>, 4> v;

@@ -74,6 +74,10 @@ inline const SpringCurve& curve_of(const SpringSettings& springs, const Spring& 
 inline bool has_mesh_curves(const SpringSettings& springs) {
     return std::any_of(springs.mesh_curve.begin(), springs.mesh_curve.end(), [](const SpringCurve& c) { return c.knots > 0; });
 }
+// Whether any spring has a curve, a grid's or a mesh cloth's.
+inline bool has_curves(const SpringSettings& springs) {
+    return springs.stretch_curve[0].knots > 0 || springs.stretch_curve[1].knots > 0 || has_mesh_curves(springs);
+}
 // A spring's elastic energy (J) at `stretch` = |d| - L0, for its k w: 0.5 k w stretch^2, or with a stretch curve
 // k w times the curve's energy_term.
 inline double spring_energy(double k, const SpringCurve& curve, double stretch, double rest) {

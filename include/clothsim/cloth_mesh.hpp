@@ -51,16 +51,26 @@ std::string cloth_mesh_problem(const std::vector<glm::dvec3>& vertices,
 // cols = the vertex count). With `stretch` (E_u, E_v): the material form (springs from membrane_springs, k = E_u w;
 // hinges k = B w); without: the per-spring form (each edge a spring of springs.structural along the axis it is
 // nearer, each hinge k = springs.bending). u_axis: the warp direction (normalised here).
+// With membrane = Triangles (material form only) the stretch and shear are membrane_triangles' and the springs'
+// weights are 0: they still measure strain, tear and carry the surface.
 Topology mesh_topology(const std::vector<glm::dvec3>& rest, const std::vector<std::array<std::uint32_t, 3>>& triangles,
-                       glm::dvec3 u_axis, std::optional<glm::dvec2> stretch);
+                       glm::dvec3 u_axis, std::optional<glm::dvec2> stretch,
+                       MembraneModel membrane = MembraneModel::Springs);
 
 // One spring per edge of the mesh, in the order mesh_topology lists them, van Gelder's for the membrane of tensile
 // stiffness stretch = (E_u, E_v); weight = k / E_u (kind
 // Structural, axis U), so springs.structural.x = E_u gives each its k. A live change of the stretch puts new
 // weights on the running cloth (MassSpring::set_spring_weights).
+// With membrane = Triangles every weight is 0 (the triangles carry the membrane).
 std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest,
                                      const std::vector<std::array<std::uint32_t, 3>>& triangles, glm::dvec3 u_axis,
-                                     glm::dvec2 stretch);
+                                     glm::dvec2 stretch, MembraneModel membrane = MembraneModel::Springs);
+
+// A constant-strain membrane triangle (spring.hpp: Membrane) for each of `triangles`, in their order: its rest
+// frame is u_axis projected on the triangle's plane (the warp) and the normal cross it (the weft).
+std::vector<Membrane> membrane_triangles(const std::vector<glm::dvec3>& rest,
+                                         const std::vector<std::array<std::uint32_t, 3>>& triangles,
+                                         glm::dvec3 u_axis);
 
 // Each vertex's share of the area (m^2): a third of each triangle it is a corner of.
 std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest,

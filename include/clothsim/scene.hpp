@@ -33,10 +33,11 @@ public:
 
 // ---- The field table: every scene field's dotted name, unit, valid range and meaning, in one place. ----
 using FieldRef = std::variant<int*, float*, bool*, glm::vec2*, glm::vec3*, std::string*, PinSpec*, StretchCurve*,
-                              WindModel*, SolverMethod*, Integrator*, ContactModel*, ClothShape*>;
+                              WindModel*, SolverMethod*, Integrator*, ContactModel*, ClothShape*, MembraneModel*>;
 using ConstFieldRef = std::variant<const int*, const float*, const bool*, const glm::vec2*, const glm::vec3*,
                                    const std::string*, const PinSpec*, const StretchCurve*, const WindModel*,
-                                   const SolverMethod*, const Integrator*, const ContactModel*, const ClothShape*>;
+                                   const SolverMethod*, const Integrator*, const ContactModel*, const ClothShape*,
+                                   const MembraneModel*>;
 
 struct FieldInfo {
     std::string_view name;  // dotted name, as in the scene file and --set
@@ -90,6 +91,7 @@ std::span<const std::string_view> solver_method_names(); // fast, textbook
 std::span<const std::string_view> integrator_names();    // verlet, symplectic-euler, rk4, implicit-euler, xpbd
 std::span<const std::string_view> contact_model_names(); // projection, penalty
 std::span<const std::string_view> cloth_shape_names();   // rectangle, disc
+std::span<const std::string_view> membrane_model_names(); // springs, triangles
 
 // The names of an enumeration field's values, by the field's type (the loader, the field table and the
 // panel treat every enumeration alike through these).
@@ -98,6 +100,7 @@ inline std::span<const std::string_view> names_of(const SolverMethod*) { return 
 inline std::span<const std::string_view> names_of(const Integrator*) { return integrator_names(); }
 inline std::span<const std::string_view> names_of(const ContactModel*) { return contact_model_names(); }
 inline std::span<const std::string_view> names_of(const ClothShape*) { return cloth_shape_names(); }
+inline std::span<const std::string_view> names_of(const MembraneModel*) { return membrane_model_names(); }
 
 // ---- Loading and overriding. All throw SceneError; on a throw the target scene is left unchanged. ----
 Scene parse_scene(std::string_view toml_text, std::string_view source_name);

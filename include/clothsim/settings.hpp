@@ -31,6 +31,12 @@ enum class ClipKind { Rigid, Soft };
 
 // The time integrator (one file each in src/core/: verlet, symplectic_euler, rk4, implicit_euler, xpbd,
 // projective).
+// How a mesh cloth's membrane (stretch and shear) is modelled (cloth_mesh.hpp, docs/MESH_CLOTH.md).
+enum class MembraneModel {
+    Springs,    // van Gelder 1998's springs on the edges: the shear follows the stretch (a central-force lattice)
+    Triangles,  // a constant-strain triangle per triangle (spring.hpp: Membrane): the material's own tensor
+};
+
 // The outline of the cloth on its grid.
 enum class ClothShape {
     Rectangle,  // every particle of the rows x cols grid
@@ -89,6 +95,7 @@ struct ClothSettings {
     std::string mesh;                        // "" = the grid
     glm::vec3 mesh_rotation{0.0f, 0.0f, 0.0f};  // degrees
     float mesh_scale = 1.0f;                 // mesh units to metres
+    MembraneModel membrane = MembraneModel::Springs;  // a mesh cloth's stretch and shear, with [material]
     std::shared_ptr<const TriangleMesh> mesh_data;  // read from `mesh` when the scene is loaded
     bool is_mesh() const { return !mesh.empty(); }
 };
@@ -113,6 +120,9 @@ struct SpringSettings {
     // A mesh cloth's material springs' curves by warp level (Spring::warp_level - 1; stretch_curve.hpp: blends of
     // both directions). Derived from material.stretch_curve on a mesh cloth.
     std::array<SpringCurve, kWarpLevels + 1> mesh_curve{};
+    // A mesh cloth's membrane triangles' curves along u_axis and v_axis (Membrane; their k is the tensor's C11 and
+    // C22). Derived from material.stretch_curve when cloth.membrane = "triangles".
+    std::array<SpringCurve, 2> membrane_curve{};
     bool operator==(const SpringSettings&) const = default;
 };
 

@@ -73,4 +73,21 @@ struct Hinge {
     float weight_v = 0.0f;
 };
 
+// A constant-strain membrane triangle of a mesh cloth (cloth.membrane = "triangles"): the material's
+// orthotropic plane-stress tensor on one triangle, instead of springs on its edges. With x_i its corners,
+// w_u = sum_i bu_i x_i and w_v = sum_i bv_i x_i are the deformed images of the rest triangle's unit warp (u)
+// and weft (v) directions (the columns of the deformation gradient F = D_s D_m^-1 in the triangle's rest frame),
+// and the strains are Baraff & Witkin 1998's conditions ("Large steps in cloth simulation", section 4.2):
+// e_u = |w_u| - 1, e_v = |w_v| - 1, the shear gamma = w_u . w_v. The energy is
+//   A (C11 U_u(e_u) + C22 U_v(e_v) + C12 e_u e_v + 0.5 C66 gamma^2),
+// U(e) = 0.5 e^2 (or a stretch curve's energy term), A the rest area, C the tensor of the material
+// (membrane.hpp: the grid's own continuum tensor, so a uniform strain stores what the grid's cells store). A
+// uniform strain of any triangulation is in equilibrium (the constant-strain patch test), which the edge springs
+// of an irregular mesh are not. bu and bv sum to 0 over the corners; bu_0 = -(bu_1 + bu_2) in double, rounded.
+struct Membrane {
+    std::array<std::uint32_t, 3> v{};
+    std::array<float, 3> bu{}, bv{};  // 1/m
+    float area = 0.0f;                // m^2
+};
+
 }  // namespace clothsim

@@ -78,6 +78,9 @@ struct Topology {
     std::vector<Spring> springs;
     std::vector<Bend> bends;  // the material form's bending (kind Bending); the per-spring form has none
     std::vector<Hinge> hinges;  // a mesh cloth's bending (kind Bending), instead of bends
+    // A mesh cloth's constant-strain triangles (cloth.membrane = "triangles"): its stretch and shear, where its
+    // edge springs then have weight 0 (they still measure strain and tear).
+    std::vector<Membrane> membranes;
     std::vector<SoftClipSpring> clip_springs;  // soft clips' particles (pins with clip = "soft")
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
     // The triangles are every grid cell's two, in row-major cell order: (00, 01, 10) and (01, 11, 10) for the

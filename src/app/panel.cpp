@@ -450,11 +450,21 @@ FabricEdit fabric_section(Scene& edit, AppState& app) {
         }
         if (app.sim.topology().mesh) {
             // Two lines, as the grid's below, so nothing moves between scenes.
+            if (!app.sim.topology().membranes.empty()) {
+                ImGui::TextDisabled("mesh: constant-strain triangles, Bergou hinges");
+                ImGui::TextDisabled("stretch and shear are the material's (i)");
+                if (ImGui::IsItemHovered()) {
+                    ImGui::SetTooltip("cloth.membrane = \"triangles\": each triangle carries the material's tensor, so a\n"
+                                      "uniform strain of any triangulation stores what the continuum stores. docs/MESH_CLOTH.md");
+                }
+                return result;
+            }
             ImGui::TextDisabled("mesh: van Gelder springs, Bergou hinges");
             ImGui::TextDisabled("on a mesh, shear is 3/8 of stretch (i)");
             if (ImGui::IsItemHovered()) {
                 ImGui::SetTooltip("Springs on triangles are a central-force lattice: its shear stiffness is 3/8 of\n"
-                                  "its tensile stiffness (the Cauchy relation). docs/MESH_CLOTH.md");
+                                  "its tensile stiffness (the Cauchy relation); cloth.membrane = \"triangles\" gives\n"
+                                  "shear its own modulus. docs/MESH_CLOTH.md");
             }
             return result;
         }

@@ -37,6 +37,7 @@ Topology in_colour_order(const Topology& topology, const ColouredXpbd& coloured)
     for (std::size_t e = 0; e < t.springs.size(); ++e) t.springs[e] = topology.springs[coloured.springs().order[e]];
     for (std::size_t e = 0; e < t.bends.size(); ++e) t.bends[e] = topology.bends[coloured.bends().order[e]];
     for (std::size_t e = 0; e < t.hinges.size(); ++e) t.hinges[e] = topology.hinges[coloured.hinges().order[e]];
+    for (std::size_t e = 0; e < t.membranes.size(); ++e) t.membranes[e] = topology.membranes[coloured.membranes().order[e]];
     return t;
 }
 
@@ -52,6 +53,7 @@ TEST_CASE("coloured XPBD: no two elements of a colour share a particle, and ever
         Scene scene = disc_on_xpbd();
         scene.pins = PinSpec{PinPreset::None, {}, 0.0f, ClipKind::Rigid};
         apply_override(scene, std::string("cloth.mesh=\"") + mesh + "\"");
+        apply_override(scene, "cloth.membrane=\"triangles\"");
         const MassSpring sim = build_simulation(scene);
         const Topology& t = sim.topology();
         const std::optional<ColouredXpbd> coloured = ColouredXpbd::for_topology(t);
@@ -81,6 +83,8 @@ TEST_CASE("coloured XPBD: no two elements of a colour share a particle, and ever
               [&](std::uint32_t j) { return std::array<std::uint32_t, 2>{t.springs[j].a, t.springs[j].b}; }, "springs");
         check(coloured->hinges(), t.hinges.size(), [&](std::uint32_t j) { return t.hinges[j].v; }, "hinges");
         CHECK(t.hinges.size() > 0);
+        check(coloured->membranes(), t.membranes.size(), [&](std::uint32_t j) { return t.membranes[j].v; }, "membranes");
+        CHECK(t.membranes.size() == t.triangles.size());
     }
 }
 
@@ -89,10 +93,13 @@ TEST_CASE("coloured XPBD is the list-order XPBD on its elements listed colour by
     Scene scene = disc_on_xpbd();
     // Curved, the knots at 0.05% and 0.1% are passed where the disc drapes over the support's rim.
     const bool curved = GENERATE(false, true);
-    INFO((curved ? "curved" : "linear"));
+    const bool triangles = GENERATE(false, true);
+    INFO((curved ? "curved" : "linear") << (triangles ? ", membrane triangles" : ", springs"));
     if (curved) apply_override(scene, "material.stretch_curve={ u = [[0.0005, 2.0], [0.001, 4.0]], v = [[0.0005, 3.0]] }");
+    if (triangles) apply_override(scene, "cloth.membrane=\"triangles\"");
     const MassSpring built = build_simulation(scene);
     REQUIRE(built.topology().mesh);
+    REQUIRE(built.topology().membranes.size() == (triangles ? built.topology().triangles.size() : 0));
     const std::optional<ColouredXpbd> coloured = ColouredXpbd::for_topology(built.topology());
     REQUIRE(coloured);
     SimulationSettings textbook = built.settings();

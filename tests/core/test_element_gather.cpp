@@ -13,8 +13,8 @@
 
 using namespace clothsim;
 
-TEST_CASE("element gather: a mesh cloth's spring and hinge forces on the team equal the list path's bit for bit, "
-          "with every kernel the CPU runs, on 1, 2 and 3 threads, linear and with stretch curves", "[element_gather]") {
+TEST_CASE("element gather: a mesh cloth's spring, hinge and membrane forces on the team equal the list path's bit for "
+          "bit, with every kernel the CPU runs, on 1, 2 and 3 threads, linear and with stretch curves", "[element_gather]") {
     // The conforming Cusick disc (1951 vertices), every particle moved at random by up to a tenth of an edge,
     // with an anisotropic fabric; one spring given stiffness 0 and one length 0, as the list path skips them.
     // Curved, the strains of up to 10% pass every knot (the springs then take the scalar loop's hinge sums).
@@ -24,12 +24,19 @@ TEST_CASE("element gather: a mesh cloth's spring and hinge forces on the team eq
     apply_override(scene, "material.stretch=[3000, 1000]");
     apply_override(scene, "material.bending=[2e-5, 1e-5]");
     const bool curved = GENERATE(false, true);
-    INFO((curved ? "curved" : "linear"));
+    const bool triangles = GENERATE(false, true);
+    INFO((curved ? "curved" : "linear") << (triangles ? ", membrane triangles" : ", springs"));
+    if (triangles) apply_override(scene, "cloth.membrane=\"triangles\"");
     if (curved) apply_override(scene, "material.stretch_curve={ u = [[0.002, 2.0], [0.01, 4.0]], v = [[0.002, 3.0], [0.02, 9.0]] }");
     const MassSpring sim = build_simulation(scene);
     Topology topology = sim.topology();
     REQUIRE(topology.mesh);
     REQUIRE(!topology.hinges.empty());
+    REQUIRE(topology.membranes.size() == (triangles ? topology.triangles.size() : 0));
+    if (triangles) {  // the springs carry nothing: one given weight below, to check both kinds on one particle
+        topology.springs[7].weight = 1.0f / 64.0f;
+        topology.membranes[11].area = 0.0f;  // a membrane of no stiffness adds zeros
+    }
     topology.springs[5].weight = 0.0f;
     DVec3Array position = sim.state().position;
     std::mt19937 rng(3);
@@ -62,6 +69,7 @@ TEST_CASE("element gather: a mesh cloth's spring and hinge forces on the team eq
     CHECK(largest > 1e-3);
     SpringSettings linear = sim.settings().springs;
     linear.mesh_curve = {};
+    linear.membrane_curve = {};
     Vec3Array straight;
     straight.resize(position.size());
     accumulate_spring_forces(topology, position, linear, straight);

@@ -181,3 +181,42 @@ TEST_CASE("cutting: a stroke across a hanging sheet parts it there, the lower pi
     CHECK(std::abs(centre(piece[top], nullptr).y - upper0.y) < 0.05);
     CHECK(sim.all_finite());
 }
+
+TEST_CASE("tearing: a cut through a mesh cloth of membrane triangles takes each cut edge's triangles with it, "
+          "and the piece cut off falls free", "[tearing][membrane]") {
+    // The Cusick disc as a mesh of constant-strain triangles held at its centre: its edges (weight 0) still measure
+    // strain and break, and the triangles across a broken edge go with it, as the drawn surface's do
+    // (cloth_surface.hpp).
+    Scene s = load_scene("cusick");
+    apply_override(s, "pins=[]");
+    apply_override(s, "cloth.mesh=\"cusick-disc-2k.obj\"");
+    apply_override(s, "cloth.origin=[0, 0.203, 0]");
+    apply_override(s, "pins=[{ vertex = 0, radius = 0.09 }]");
+    apply_override(s, "cloth.membrane=\"triangles\"");
+    MassSpring sim = build_simulation(s);
+    REQUIRE(sim.topology().membranes.size() == sim.topology().triangles.size());
+    // A stroke across the disc, outside the support, cuts it in two.
+    const std::size_t cut = sim.cut([](glm::vec3 a, glm::vec3 b) { return (a.x - 0.1f) * (b.x - 0.1f) < 0.0f; });
+    REQUIRE(cut > 0);
+    const Topology& t = sim.topology();
+    REQUIRE(t.membranes.size() == t.triangles.size());
+    for (std::size_t i = 0; i < t.membranes.size(); ++i) CHECK(t.membranes[i].v == t.triangles[i]);
+    for (const Membrane& m : t.membranes) {
+        for (int i = 0; i < 3; ++i) CHECK(has_spring(t, m.v[i], m.v[(i + 1) % 3]));
+    }
+    const std::vector<std::uint32_t> piece = connected_pieces(t, sim.particle_count());
+    std::size_t outside = 0;
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        if (sim.position(i).x > 0.1f) {
+            CHECK(piece[i] != piece[0]);
+            ++outside;
+        }
+    }
+    REQUIRE(outside > 0);
+    // The piece cut off falls free: nothing of the triangles holds it to the pinned rest.
+    sim.run_steps(30);
+    REQUIRE(sim.all_finite());
+    for (std::size_t i = 0; i < sim.particle_count(); ++i) {
+        if (piece[i] != piece[0]) CHECK(sim.position(i).y < 0.203f - 0.1f);  // half a second of fall: over 1 m
+    }
+}

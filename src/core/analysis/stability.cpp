@@ -1,6 +1,7 @@
 #include "clothsim/stability.hpp"
 
 #include "model/forces.hpp"
+#include "model/membrane.hpp"
 #include "collision/penalty_contact.hpp"
 
 #include <glm/geometric.hpp>
@@ -123,6 +124,23 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
         const double total = std::abs(double(h.c[0])) + std::abs(double(h.c[1])) + std::abs(double(h.c[2])) +
                              std::abs(double(h.c[3]));
         for (int i = 0; i < 4; ++i) row_sum[h.v[i]] += k * std::abs(double(h.c[i])) * total;
+    }
+    // A membrane triangle's Hessian at small strain, block (i, j) = A (C11 bu_i bu_j n_u n_u^T + C22 bv_i bv_j n_v n_v^T
+    // + C12 (bu_i bv_j n_u n_v^T + bv_i bu_j n_v n_u^T) + C66 (bu_i n_v + bv_i n_u)(bu_j n_v + bv_j n_u)^T): each
+    // rank-one term's norm bounds its share of the block's, a curved direction at its steepest tangent.
+    if (!topology.membranes.empty()) {
+        const MembraneTensor tensor = membrane_tensor(settings.springs);
+        const double tu = settings.springs.membrane_curve[0].steepest(), tv = settings.springs.membrane_curve[1].steepest();
+        steepest_tangent = std::max({steepest_tangent, tu, tv});
+        for (const Membrane& m : topology.membranes) {
+            double su = 0.0, sv = 0.0;  // sum_j |bu_j|, sum_j |bv_j|
+            for (int j = 0; j < 3; ++j) su += std::abs(double(m.bu[j])), sv += std::abs(double(m.bv[j]));
+            for (int i = 0; i < 3; ++i) {
+                const double bu = std::abs(double(m.bu[i])), bv = std::abs(double(m.bv[i]));
+                row_sum[m.v[i]] += double(m.area) * (tensor.c11 * tu * bu * su + tensor.c22 * tv * bv * sv +
+                                                     tensor.c12 * (bu * sv + bv * su) + tensor.c66 * (bu + bv) * (su + sv));
+            }
+        }
     }
     for (const SoftClipSpring& h : topology.clip_springs) row_sum[h.particle] += h.stiffness;
     double gershgorin = 0.0, gershgorin_now = 0.0;

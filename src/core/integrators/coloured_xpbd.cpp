@@ -214,6 +214,7 @@ std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology)
     for (const Spring& s : topology.springs) n = std::max<std::size_t>(n, std::max(s.a, s.b) + std::size_t{1});
     for (const Bend& b : topology.bends) n = std::max<std::size_t>(n, std::max({b.a, b.m, b.b}) + std::size_t{1});
     for (const Hinge& h : topology.hinges) n = std::max<std::size_t>(n, *std::max_element(h.v.begin(), h.v.end()) + std::size_t{1});
+    for (const Membrane& m : topology.membranes) n = std::max<std::size_t>(n, *std::max_element(m.v.begin(), m.v.end()) + std::size_t{1});
     ColouredXpbd out;
     auto springs = colour(topology.springs.size(), n, [&](std::size_t j) {
         return std::array<std::uint32_t, 2>{topology.springs[j].a, topology.springs[j].b};
@@ -223,7 +224,9 @@ std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology)
         return std::array<std::uint32_t, 3>{b.a, b.m, b.b};
     });
     auto hinges = colour(topology.hinges.size(), n, [&](std::size_t j) { return topology.hinges[j].v; });
-    if (!springs || !bends || !hinges) return std::nullopt;
+    auto membranes = colour(topology.membranes.size(), n, [&](std::size_t j) { return topology.membranes[j].v; });
+    if (!springs || !bends || !hinges || !membranes) return std::nullopt;
+    out.membranes_ = std::move(*membranes);
     out.springs_ = std::move(*springs);
     out.bends_ = std::move(*bends);
     out.hinges_ = std::move(*hinges);
@@ -298,6 +301,7 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
     multipliers.spring.resize(topology.springs.size());
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
     multipliers.hinge.resize(topology.hinges.size());
+    multipliers.membrane.resize(topology.membranes.size());
     // Each colour in pieces of kPiece elements (small enough that a descheduled thread holds up little:
     // work_team.hpp); each piece's sum of C^2 in its own slot, summed in piece order: the same for any team.
     // With the AVX-512 kernel (FastSolver's choice, so the tests run every kernel the CPU has), springs and
@@ -337,6 +341,15 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
         if (wide) return hinges_avx512(state, begin, end, multipliers);
         double v = 0.0;
         for (std::uint32_t e = begin; e < end; ++e) v += hinge_one(state, e, multipliers);
+        return v;
+    });
+    const MembraneTensor tensor = membrane_tensor(springs);
+    project(membranes_, [&](std::uint32_t begin, std::uint32_t end) {  // a mesh cloth's triangles, in the scalar order
+        double v = 0.0;
+        for (std::uint32_t e = begin; e < end; ++e) {
+            const std::uint32_t j = membranes_.order[e];
+            v += project_membrane(state, topology.membranes[j], tensor, springs, h, multipliers.membrane[j]);
+        }
         return v;
     });
 

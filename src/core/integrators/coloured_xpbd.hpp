@@ -4,7 +4,7 @@
 // The same method and arithmetic per constraint as step_xpbd (integrators.hpp: Macklin et al. 2016, one
 // projection per substep as in "Small Steps", Macklin et al. 2019), in another order. step_xpbd projects the
 // elements in list order, each waiting for the positions the one before wrote, so no two can run at once.
-// Here each kind of element (springs, then bends, then hinges, as step_xpbd) is split into colours by a greedy
+// Here each kind of element (springs, then bends, then hinges, then membranes, as step_xpbd) is split into colours by a greedy
 // graph colouring (each element takes the lowest colour that no element sharing a particle with it has taken
 // yet, in list order; Welsh & Powell 1967's greedy scheme, as in Fratarcangeli & Pellacini 2015 for
 // position-based dynamics on the GPU). The elements of one colour share no particle: each reads and writes
@@ -55,6 +55,7 @@ public:
     const Colours& springs() const { return springs_; }
     const Colours& bends() const { return bends_; }
     const Colours& hinges() const { return hinges_; }
+    const Colours& membranes() const { return membranes_; }
 
 private:
     ColouredXpbd() = default;
@@ -66,7 +67,7 @@ private:
     double springs_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
     double hinges_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
 
-    Colours springs_, bends_, hinges_;
+    Colours springs_, bends_, hinges_, membranes_;
     // The springs' and hinges' data in colour order (entry e is element order[e]), what a colour's pass reads
     // contiguously: particles, rest lengths and weights, k w (0: not projected) and alpha~ = 1 / (k w h^2).
     struct SpringData {

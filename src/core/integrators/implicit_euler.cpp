@@ -2,6 +2,7 @@
 #include "integrators/integrator_step.hpp"
 
 #include "model/forces.hpp"
+#include "model/membrane.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -62,6 +63,32 @@ void spring_jacobian_times(const Topology& topology, const DVec3Array& position,
         for (int i = 0; i < 4; ++i) sum += h.c[i] * u.get(h.v[i]);
         const glm::vec3 e = k * sum;
         for (int i = 0; i < 4; ++i) out.add(h.v[i], -h.c[i] * e);
+    }
+    // Membrane triangles (membrane.hpp), in double: with dw = sum_i b_i u_i, the strains change by
+    // de_u = n_u . dw_u, de_v = n_v . dw_v, dgamma = w_v . dw_u + w_u . dw_v, the stresses by the tensor (a curve's
+    // tangent on its direction), and K u on corner i is bu_i dp_u + bv_i dp_v with
+    // dp_u = -A (dsigma_u n_u + max(sigma_u, 0) (I - n_u n_u^T) dw_u / |w_u| + dtau w_v), dp_v likewise. The
+    // stretch's transverse term is dropped under compression and the shear's tau (bu bv^T + bv bu^T) always, as
+    // the compressed springs' above: -K stays positive semi-definite.
+    if (topology.membranes.empty()) return;
+    const MembraneTensor c = membrane_tensor(springs);
+    for (const Membrane& m : topology.membranes) {
+        const MembraneStrain s = membrane_strain(position, m, c, springs);
+        if (!s.valid) continue;
+        glm::dvec3 du(0.0), dv(0.0);
+        for (int i = 0; i < 3; ++i) {
+            du += double(m.bu[i]) * glm::dvec3(u.get(m.v[i]));
+            dv += double(m.bv[i]) * glm::dvec3(u.get(m.v[i]));
+        }
+        const glm::dvec3 nu = s.wu / s.lu, nv = s.wv / s.lv;
+        const double deu = glm::dot(nu, du), dev = glm::dot(nv, dv);
+        const double dsu = c.c11 * springs.membrane_curve[0].tangent(s.eu) * deu + c.c12 * dev;
+        const double dsv = c.c22 * springs.membrane_curve[1].tangent(s.ev) * dev + c.c12 * deu;
+        const double dtau = c.c66 * (glm::dot(s.wv, du) + glm::dot(s.wu, dv));
+        const double a = -double(m.area);
+        const glm::dvec3 pu = a * (dsu * nu + (std::max(s.sigma_u, 0.0) / s.lu) * (du - deu * nu) + dtau * s.wv);
+        const glm::dvec3 pv = a * (dsv * nv + (std::max(s.sigma_v, 0.0) / s.lv) * (dv - dev * nv) + dtau * s.wu);
+        for (int i = 0; i < 3; ++i) out.add(m.v[i], glm::vec3(double(m.bu[i]) * pu + double(m.bv[i]) * pv));
     }
 }
 

@@ -66,6 +66,7 @@ struct XpbdMultipliers {
     std::vector<double> spring;     // per spring
     std::vector<glm::dvec3> bend;   // per bend (a vector constraint)
     std::vector<glm::dvec3> hinge;  // per hinge (a vector constraint)
+    std::vector<glm::dvec3> membrane;  // per membrane triangle: (e_u, e_v, gamma)'s
     double substep = 0.0;           // s
     double initial_violation = 0.0; // |C| at the prediction, over all springs and bends
 };

@@ -2,6 +2,7 @@
 #include "integrators/integrator_step.hpp"
 
 #include "model/forces.hpp"
+#include "model/membrane.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -105,7 +106,8 @@ std::shared_ptr<const ProjectiveSolver::Factor> factorise(const State& state, co
     const double inertia_scale = (1.0 + h_hat * damping) / (h_hat * h_hat);
     f->inertia.resize(rows);
     std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(rows + 4 * topology.springs.size() + 9 * topology.bends.size() + 16 * topology.hinges.size());
+    entries.reserve(rows + 4 * topology.springs.size() + 9 * topology.bends.size() + 16 * topology.hinges.size() +
+                    9 * topology.membranes.size());
     for (int r = 0; r < rows; ++r) {
         f->inertia[r] = inertia_scale * state.mass[f->particle[r]];
         entries.emplace_back(r, r, f->inertia[r]);
@@ -147,6 +149,20 @@ std::shared_ptr<const ProjectiveSolver::Factor> factorise(const State& state, co
         if (k == 0.0) continue;
         for (int i = 0; i < 4; ++i) {
             for (int j = 0; j < 4; ++j) add(h.v[i], h.v[j], k * double(h.c[i]) * double(h.c[j]));
+        }
+    }
+    // A membrane triangle (membrane.hpp) is not quadratic: the matrix takes A (C11 bu bu^T + C22 bv bv^T), its
+    // stretch's stiffness at rest, as a spring's k; the local step's right-hand side then gives the true
+    // gradient (below), and the quasi-Newton iterations add what the matrix misses (its shear).
+    if (!topology.membranes.empty()) {
+        const MembraneTensor c = membrane_tensor(springs);
+        for (const Membrane& m : topology.membranes) {
+            const double ku = double(m.area) * c.c11, kv = double(m.area) * c.c22;
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) {
+                    add(m.v[i], m.v[j], ku * double(m.bu[i]) * double(m.bu[j]) + kv * double(m.bv[i]) * double(m.bv[j]));
+                }
+            }
         }
     }
     f->matrix.resize(rows, rows);
@@ -290,6 +306,24 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
         for (const Hinge& hinge : topology.hinges) {
             const glm::dvec3 d = hinge_difference(position, hinge);
             e += 0.5 * double(stiffness_of(springs, hinge)) * glm::dot(d, d);
+        }
+        // A membrane's share of b(x): its matrix entries times x plus its forces, so that A x - b(x) is minus its
+        // force (A's bu bu^T x on corner i is bu_i w_u).
+        if (!topology.membranes.empty()) {
+            const MembraneTensor tensor = membrane_tensor(springs);
+            for (const Membrane& m : topology.membranes) {
+                e += membrane_energy(position, m, tensor, springs);
+                glm::dvec3 pu(0.0), pv(0.0);
+                membrane_forces(position, m, tensor, springs, pu, pv);
+                const glm::dvec3 qu = double(m.area) * tensor.c11 * membrane_direction(position, m, m.bu) + pu;
+                const glm::dvec3 qv = double(m.area) * tensor.c22 * membrane_direction(position, m, m.bv) + pv;
+                for (int i = 0; i < 3; ++i) {
+                    const int r = f.free_index[m.v[i]];
+                    if (r < 0) continue;
+                    const glm::dvec3 b = double(m.bu[i]) * qu + double(m.bv[i]) * qv;
+                    rhs.row(r) += Eigen::RowVector3d(b.x, b.y, b.z);
+                }
+            }
         }
         for (const SoftClipSpring& hold : topology.clip_springs) {
             const glm::dvec3 d = position.get(hold.particle) - hold.anchor;

@@ -25,12 +25,13 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         if (state.pinned[i]) continue;
         state.position.add(i, state.motion.get(i) + a.get(i) * (h * h));  // x + h (v + h a)
     }
-    // One Gauss-Seidel pass over the springs, then the bends, then the hinges, in list order
+    // One Gauss-Seidel pass over the springs, then the bends, then the hinges, then the membranes, in list order
     // (xpbd_projection.hpp). GridXpbd (grid_xpbd.hpp) and ColouredXpbd (coloured_xpbd.hpp) do the same
     // arithmetic in other orders.
     multipliers.spring.assign(topology.springs.size(), 0.0);
     multipliers.bend.assign(topology.bends.size(), glm::dvec3(0.0));
     multipliers.hinge.assign(topology.hinges.size(), glm::dvec3(0.0));
+    multipliers.membrane.assign(topology.membranes.size(), glm::dvec3(0.0));
     double violation2 = 0.0;
     for (std::size_t j = 0; j < topology.springs.size(); ++j) {
         const double k = stiffness_of(springs, topology.springs[j]);
@@ -47,6 +48,12 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
         const double k = stiffness_of(springs, topology.hinges[j]);
         if (k != 0.0) violation2 += project_hinge(state, topology.hinges[j], k, h, multipliers.hinge[j]);
     }
+    if (!topology.membranes.empty()) {
+        const MembraneTensor c = membrane_tensor(springs);
+        for (std::size_t j = 0; j < topology.membranes.size(); ++j) {
+            violation2 += project_membrane(state, topology.membranes[j], c, springs, h, multipliers.membrane[j]);
+        }
+    }
     for (std::size_t i = 0; i < n; ++i) {
         state.motion.set(i, state.pinned[i] ? glm::dvec3(0.0) : state.position.get(i) - start.get(i));
     }
@@ -57,7 +64,7 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
 double xpbd_residual(const DVec3Array& position, const Topology& topology, const SpringSettings& springs,
                      const XpbdMultipliers& multipliers) {
     if (multipliers.spring.size() != topology.springs.size() || multipliers.bend.size() != topology.bends.size() ||
-        multipliers.hinge.size() != topology.hinges.size()) {
+        multipliers.hinge.size() != topology.hinges.size() || multipliers.membrane.size() != topology.membranes.size()) {
         return 0.0;  // no XPBD substep yet
     }
     const double h2 = multipliers.substep * multipliers.substep;
@@ -83,6 +90,13 @@ double xpbd_residual(const DVec3Array& position, const Topology& topology, const
         if (k == 0.0) continue;
         const glm::dvec3 r = hinge_difference(position, hinge) + multipliers.hinge[j] / (k * h2);
         residual2 += glm::dot(r, r);
+    }
+    if (!topology.membranes.empty()) {
+        const MembraneTensor c = membrane_tensor(springs);
+        for (std::size_t j = 0; j < topology.membranes.size(); ++j) {
+            const glm::dvec3 r = membrane_residual(position, topology.membranes[j], c, springs, h2, multipliers.membrane[j]);
+            residual2 += glm::dot(r, r);
+        }
     }
     const double first = multipliers.initial_violation;
     return first > 0.0 ? std::sqrt(residual2) / first : 0.0;

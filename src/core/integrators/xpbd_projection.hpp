@@ -8,6 +8,10 @@
 #include "clothsim/state.hpp"
 
 #include "model/forces.hpp"
+#include "model/membrane.hpp"
+
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 
 #include <array>
 #include <cmath>
@@ -81,6 +85,71 @@ inline double project_hinge(State& state, const Hinge& hinge, double k, double h
     return project_hinge(state, {hinge.v[0], hinge.v[1], hinge.v[2], hinge.v[3]},
                          {double(hinge.c[0]), double(hinge.c[1]), double(hinge.c[2]), double(hinge.c[3])},
                          1.0 / (k * h * h), lambda);
+}
+
+// A membrane triangle (membrane.hpp) as one block of three constraints C = (e_u, e_v, gamma), whose energy
+// 0.5 C^T K C with K = A [[C11, C12, 0], [C12, C22, 0], [0, 0, C66]] is the membrane's (Macklin, Mueller &
+// Chentanez 2016 treat a block of constraints with a compliance matrix alpha = K^-1 alike): one Newton step of
+// (J W J^T + alpha~) d_lambda = -C, alpha~ = K^-1 / h^2, with the gradients of membrane_forces. A curved
+// direction takes its secant C11 t(e) / e (as curved_compliance), so the fixed point's stress is the curve's.
+// Returns |C|^2 and leaves the multipliers in `lambda`; a collapsed triangle or a zero stretch is left alone.
+inline bool membrane_compliance(const MembraneTensor& c, const SpringSettings& springs, const MembraneStrain& s,
+                                  double area, double h2, glm::dmat3& alpha) {
+    auto secant = [](const SpringCurve& curve, double e) {
+        return curve.knots == 0 || !(e > 0.0) ? 1.0 : curve.stretch_term(e, 1.0) / e;
+    };
+    const double k11 = area * c.c11 * secant(springs.membrane_curve[0], s.eu);
+    const double k22 = area * c.c22 * secant(springs.membrane_curve[1], s.ev);
+    const double k12 = area * c.c12, det = k11 * k22 - k12 * k12;
+    if (!(k11 > 0.0) || !(k22 > 0.0) || !(det > 0.0)) return false;
+    alpha = glm::dmat3(0.0);
+    alpha[0][0] = k22 / (det * h2);
+    alpha[1][1] = k11 / (det * h2);
+    alpha[0][1] = alpha[1][0] = -k12 / (det * h2);
+    alpha[2][2] = c.c66 > 0.0 ? 1.0 / (area * c.c66 * h2) : 0.0;  // 0 marks a shear that is not projected
+    return true;
+}
+
+inline double project_membrane(State& state, const Membrane& m, const MembraneTensor& c, const SpringSettings& springs,
+                               double h, glm::dvec3& lambda) {
+    lambda = glm::dvec3(0.0);
+    const MembraneStrain s = membrane_strain(state.position, m, c, springs);
+    if (!s.valid) return 0.0;
+    glm::dmat3 alpha;
+    if (!membrane_compliance(c, springs, s, double(m.area), h * h, alpha)) return 0.0;
+    const bool shear = alpha[2][2] > 0.0;
+    // Each corner's gradients: bu_i n_u, bv_i n_v and bu_i w_v + bv_i w_u.
+    const glm::dvec3 nu = s.wu / s.lu, nv = s.wv / s.lv;
+    std::array<std::array<glm::dvec3, 3>, 3> grad;
+    std::array<double, 3> w;
+    for (int i = 0; i < 3; ++i) {
+        w[i] = double(state.inverse_mass[m.v[i]]);
+        const double bu = double(m.bu[i]), bv = double(m.bv[i]);
+        grad[i] = {bu * nu, bv * nv, shear ? bu * s.wv + bv * s.wu : glm::dvec3(0.0)};
+    }
+    glm::dmat3 a = alpha;  // J W J^T + alpha~ (column-major; symmetric)
+    for (int p = 0; p < 3; ++p) {
+        for (int q = 0; q < 3; ++q) {
+            for (int i = 0; i < 3; ++i) a[q][p] += w[i] * glm::dot(grad[i][p], grad[i][q]);
+        }
+    }
+    if (!shear) a[2][2] = 1.0;  // d_lambda_gamma = 0
+    const glm::dvec3 C(s.eu, s.ev, shear ? s.gamma : 0.0);
+    lambda = glm::inverse(a) * -C;
+    for (int i = 0; i < 3; ++i) {
+        if (w[i] == 0.0) continue;
+        state.position.add(m.v[i], w[i] * (lambda.x * grad[i][0] + lambda.y * grad[i][1] + lambda.z * grad[i][2]));
+    }
+    return glm::dot(C, C);
+}
+
+// A membrane's residual C + alpha~ lambda at `position` (3 components).
+inline glm::dvec3 membrane_residual(const DVec3Array& position, const Membrane& m, const MembraneTensor& c,
+                                    const SpringSettings& springs, double h2, const glm::dvec3& lambda) {
+    const MembraneStrain s = membrane_strain(position, m, c, springs);
+    glm::dmat3 alpha;
+    if (!s.valid || !membrane_compliance(c, springs, s, double(m.area), h2, alpha)) return glm::dvec3(0.0);
+    return glm::dvec3(s.eu, s.ev, alpha[2][2] > 0.0 ? s.gamma : 0.0) + alpha * lambda;
 }
 
 }  // namespace clothsim

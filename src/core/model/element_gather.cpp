@@ -3,6 +3,7 @@
 #include "integrators/fast_solver.hpp"
 #include "integrators/work_team.hpp"
 #include "model/forces.hpp"
+#include "model/membrane.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -26,15 +27,24 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
     ElementGather g;
     g.springs = topology.springs.size();
     g.hinges = topology.hinges.size();
+    g.membranes = topology.membranes.size();
     const std::size_t n = static_cast<std::size_t>(topology.rows) * static_cast<std::size_t>(topology.cols);
     g.begin.assign(n + 1, 0);
-    auto each = [&](auto&& visit) {  // in list order: springs, then hinges
+    auto each = [&](auto&& visit) {  // in list order: springs, then hinges, then membranes
         for (std::size_t j = 0; j < g.springs; ++j) {
             visit(topology.springs[j].a, j, 1.0f);
             visit(topology.springs[j].b, j, -1.0f);
         }
         for (std::size_t h = 0; h < g.hinges; ++h) {
             for (std::size_t slot = 0; slot < 4; ++slot) visit(topology.hinges[h].v[slot], g.springs + h, -topology.hinges[h].c[slot]);
+        }
+        for (std::size_t m = 0; m < g.membranes; ++m) {
+            const Membrane& t = topology.membranes[m];
+            const std::size_t slot = g.springs + g.hinges + 2 * m;
+            for (std::size_t i = 0; i < 3; ++i) {
+                visit(t.v[i], slot, t.bu[i]);
+                visit(t.v[i], slot + 1, t.bv[i]);
+            }
         }
     };
     each([&](std::uint32_t particle, std::size_t, float) { ++g.begin[particle + 1]; });
@@ -46,7 +56,7 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
         g.source[fill[particle]] = static_cast<std::uint32_t>(element);
         g.coefficient[fill[particle]++] = c;
     });
-    g.element_force.resize(g.springs + g.hinges);
+    g.element_force.resize(g.springs + g.hinges + 2 * g.membranes);
     for (const Spring& sp : topology.springs) {
         g.spring_a.push_back(static_cast<std::int32_t>(sp.a));
         g.spring_b.push_back(static_cast<std::int32_t>(sp.b));
@@ -206,11 +216,13 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
     using Vec = glm::vec3;
     WorkTeam& team = WorkTeam::shared();
     const int spring_pieces = WorkTeam::pieces(g.springs, kPiece), hinge_pieces = WorkTeam::pieces(g.hinges, kPiece);
+    const int membrane_pieces = WorkTeam::pieces(g.membranes, kPiece);
+    const MembraneTensor tensor = membrane_tensor(springs);
     // Each element's force, as accumulate_spring_forces computes it (an element it skips gets zero, which adds
     // nothing: a sum that starts at +0 never becomes -0).
     const bool wide = FastSolver::kernel() == FastKernel::Avx512;
     const bool curved = has_mesh_curves(springs);  // springs with curves in the scalar loop (its hinge sums)
-    team.run(threads, spring_pieces + hinge_pieces, [&](int piece, int) {
+    team.run(threads, spring_pieces + hinge_pieces + membrane_pieces, [&](int piece, int) {
         if (piece < spring_pieces) {
             const std::size_t first = static_cast<std::size_t>(piece) * kPiece, last = std::min(g.springs, first + kPiece);
             if (wide && !curved) {
@@ -231,6 +243,18 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
                     }
                 }
                 g.element_force.set(j, f);
+            }
+            return;
+        }
+        if (piece >= spring_pieces + hinge_pieces) {  // membranes: p_u and p_v (membrane.hpp), in the scalar order
+            const std::size_t first = static_cast<std::size_t>(piece - spring_pieces - hinge_pieces) * kPiece;
+            const std::size_t last = std::min(g.membranes, first + kPiece);
+            const std::size_t base = g.springs + g.hinges;
+            for (std::size_t m = first; m < last; ++m) {
+                Vec pu(0.0f), pv(0.0f);
+                if (!membrane_forces(position, topology.membranes[m], tensor, springs, pu, pv)) pu = pv = Vec(0.0f);
+                g.element_force.set(base + 2 * m, pu);
+                g.element_force.set(base + 2 * m + 1, pv);
             }
             return;
         }

@@ -1,4 +1,4 @@
-// The spring and hinge forces of a cloth on a team of threads, as a gather: each element's force is computed
+// The spring, hinge and membrane forces of a cloth on a team of threads, as a gather: each element's force is computed
 // once, in parallel over the elements (a spring's f_a, a hinge's k sum_i c_i x_i), then each particle sums the
 // forces of its own elements, in parallel over the particles, from a compressed list of them by particle (CSR).
 // Nothing is scattered, so no two threads write one particle.
@@ -21,11 +21,12 @@ namespace clothsim {
 struct ElementGather {
     // Particle i's terms are [begin[i], begin[i + 1]): it adds coefficient[k] * element_force[source[k]] for
     // each k, in list order. element_force holds the springs' forces on their end a (j) and then the hinges'
-    // e = k sum_i c_i x_i (springs + h); a spring's coefficient is +1 at end a and -1 at end b (exact: the
-    // product is the force or its negation), a hinge's is -c_slot.
+    // e = k sum_i c_i x_i (springs + h), then each membrane's p_u and p_v (membrane.hpp; springs + hinges + 2 m
+    // and the next); a spring's coefficient is +1 at end a and -1 at end b (exact: the product is the force or
+    // its negation), a hinge's is -c_slot, a membrane's bu_i on p_u and bv_i on p_v.
     std::vector<std::uint32_t> begin, source;
     std::vector<float> coefficient;
-    std::size_t springs = 0, hinges = 0;
+    std::size_t springs = 0, hinges = 0, membranes = 0;
     Vec3Array element_force;
     // The elements as the AVX-512 element pass reads them, in list order: a spring's ends, rest length, weight
     // and which stiffness of the settings it takes (0 structural u, 1 structural v, 2 shear, 3 bending u, 4

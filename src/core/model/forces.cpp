@@ -1,5 +1,7 @@
 #include "model/forces.hpp"
 
+#include "model/membrane.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <array>
@@ -42,6 +44,16 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
         if (kh == T(0)) continue;
         const Vec e = kh * Vec(hinge_difference(position, h));
         for (int i = 0; i < 4; ++i) force.add(h.v[i], -T(h.c[i]) * e);
+    }
+    if (topology.membranes.empty()) return;
+    const MembraneTensor c = membrane_tensor(springs);
+    for (const Membrane& m : topology.membranes) {
+        Vec pu, pv;
+        if (!membrane_forces(position, m, c, springs, pu, pv)) continue;
+        for (int i = 0; i < 3; ++i) {
+            force.add(m.v[i], T(m.bu[i]) * pu);
+            force.add(m.v[i], T(m.bv[i]) * pv);
+        }
     }
 }
 
@@ -117,6 +129,10 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
     for (const Hinge& h : topology.hinges) {
         const glm::dvec3 d = hinge_difference(position, h);
         energy += 0.5 * double(stiffness_of(springs, h)) * glm::dot(d, d);
+    }
+    if (!topology.membranes.empty()) {
+        const MembraneTensor c = membrane_tensor(springs);
+        for (const Membrane& m : topology.membranes) energy += membrane_energy(position, m, c, springs);
     }
     for (const SoftClipSpring& h : topology.clip_springs) {
         const glm::dvec3 d = position.get(h.particle) - h.anchor;

@@ -56,6 +56,11 @@ std::size_t break_springs(Topology& topology, const std::function<bool(const Spr
     });
     const std::size_t removed = before - topology.springs.size() - topology.bends.size() - topology.hinges.size();
     if (removed == 0) return 0;
+    // A membrane triangle goes with any of its edges, as the triangle it is.
+    std::erase_if(topology.membranes, [&](const Membrane& m) {
+        return broken.count(pair_key(m.v[0], m.v[1])) != 0 || broken.count(pair_key(m.v[1], m.v[2])) != 0 ||
+               broken.count(pair_key(m.v[2], m.v[0])) != 0;
+    });
     const std::size_t triangles = topology.triangles.size();
     std::erase_if(topology.triangles, [&](const std::array<std::uint32_t, 3>& t) {
         return broken.count(pair_key(t[0], t[1])) != 0 || broken.count(pair_key(t[1], t[2])) != 0 ||

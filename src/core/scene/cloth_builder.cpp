@@ -256,6 +256,10 @@ void apply_fabric(MassSpring& sim, const Scene& scene) {
             throw SceneError(std::string("switching a mesh cloth between [material] and per-spring values changes its "
                                          "springs' and hinges' weights: rebuild the cloth"));
         }
+        const bool triangles = scene.material.enabled && scene.cloth.membrane == MembraneModel::Triangles;
+        if (triangles == topology.membranes.empty()) {
+            throw SceneError("switching cloth.membrane between springs and triangles changes the cloth's elements: rebuild it");
+        }
         if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
         Scene derived = scene;
         derive_springs(derived);
@@ -264,7 +268,7 @@ void apply_fabric(MassSpring& sim, const Scene& scene) {
         settings.springs.shear = derived.settings.springs.shear;
         settings.springs.bending = derived.settings.springs.bending;
         const std::vector<glm::dvec3> rest = placed_cloth_vertices(derived.cloth);
-        if (scene.material.enabled) {
+        if (scene.material.enabled && !triangles) {  // the triangles' stiffness is the settings' (membrane.hpp)
             sim.set_spring_weights(membrane_springs(rest, derived.cloth.mesh_data->triangles(), glm::dvec3(derived.cloth.u_axis),
                                                     glm::dvec2(derived.material.stretch)));
         }
@@ -329,7 +333,8 @@ MassSpring build_mesh_simulation(const Scene& scene) {
         state.inverse_mass[i] = 0.0f;
     }
     Topology topology = mesh_topology(rest, triangles, glm::dvec3(cloth.u_axis),
-                                      scene.material.enabled ? std::optional(glm::dvec2(derived.material.stretch)) : std::nullopt);
+                                      scene.material.enabled ? std::optional(glm::dvec2(derived.material.stretch)) : std::nullopt,
+                                      scene.material.enabled ? cloth.membrane : MembraneModel::Springs);
     // Soft clips as on the grid: k = kappa A w, kappa = kClipHoldFactor E / R^2, A the vertex's area, E the
     // springs' stretch along u and v (springs.structural on a mesh).
     for (const ClipWeight& w : soft_clip_weights(cloth, scene.pins)) {

@@ -210,7 +210,7 @@ std::string cloth_mesh_problem(const std::vector<glm::dvec3>& vertices, const Tr
 }
 
 std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const Triangles& triangles,
-                                     glm::dvec3 u_axis, glm::dvec2 stretch) {
+                                     glm::dvec3 u_axis, glm::dvec2 stretch, MembraneModel membrane) {
     const glm::dvec3 u = glm::normalize(u_axis);
     std::vector<Spring> springs;
     for (const EdgeUse& e : edge_uses(triangles)) {
@@ -223,9 +223,35 @@ std::vector<Spring> membrane_springs(const std::vector<glm::dvec3>& rest, const 
         // The rest length in the spring kernels' arithmetic, as the grid's (cloth_builder.cpp); k = E_u w.
         const auto level = static_cast<std::uint8_t>(1 + std::lround(cu * kWarpLevels));
         springs.push_back({e.a, e.b, glm::length(glm::vec3(d)), SpringKind::Structural, Axis::U, level,
-                           static_cast<float>(k / stretch.x)});
+                           membrane == MembraneModel::Triangles ? 0.0f : static_cast<float>(k / stretch.x)});
     }
     return springs;
+}
+
+std::vector<Membrane> membrane_triangles(const std::vector<glm::dvec3>& rest, const Triangles& triangles,
+                                         glm::dvec3 u_axis) {
+    const glm::dvec3 u_dir = glm::normalize(u_axis);
+    std::vector<Membrane> out;
+    out.reserve(triangles.size());
+    for (const auto& t : triangles) {
+        const glm::dvec3 e1 = rest[t[1]] - rest[t[0]], e2 = rest[t[2]] - rest[t[0]];
+        const glm::dvec3 n = glm::normalize(glm::cross(e1, e2));
+        // The warp in the triangle's plane: u_axis projected on it (an edge where u_axis is the normal).
+        glm::dvec3 u = u_dir - glm::dot(u_dir, n) * n;
+        u = glm::length(u) > 1e-6 ? glm::normalize(u) : glm::normalize(e1);
+        const glm::dvec3 v = glm::cross(n, u);
+        // The rest edges in the (u, v) frame, D_m = [a b]; w = D_s D_m^-1 (det = 2 A > 0: (u, v, n) is right-handed).
+        const glm::dvec2 a(glm::dot(e1, u), glm::dot(e1, v)), b(glm::dot(e2, u), glm::dot(e2, v));
+        const double det = a.x * b.y - b.x * a.y;
+        Membrane m;
+        m.v = t;
+        const double bu1 = b.y / det, bu2 = -a.y / det, bv1 = -b.x / det, bv2 = a.x / det;
+        m.bu = {float(-(bu1 + bu2)), float(bu1), float(bu2)};
+        m.bv = {float(-(bv1 + bv2)), float(bv1), float(bv2)};
+        m.area = float(0.5 * det);
+        out.push_back(m);
+    }
+    return out;
 }
 
 std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest, const Triangles& triangles) {
@@ -239,7 +265,7 @@ std::vector<double> vertex_areas(const std::vector<glm::dvec3>& rest, const Tria
 }
 
 Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& triangles, glm::dvec3 u_axis,
-                       std::optional<glm::dvec2> stretch) {
+                       std::optional<glm::dvec2> stretch, MembraneModel membrane) {
     const bool material = stretch.has_value();
     const glm::dvec3 u = glm::normalize(u_axis);
     Topology t;
@@ -254,7 +280,8 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
         return std::clamp(c * c / glm::dot(d, d), 0.0, 1.0);
     };
     const std::vector<EdgeUse> edges = edge_uses(triangles);
-    if (material) t.springs = membrane_springs(rest, triangles, u_axis, *stretch);
+    if (material) t.springs = membrane_springs(rest, triangles, u_axis, *stretch, membrane);
+    if (material && membrane == MembraneModel::Triangles) t.membranes = membrane_triangles(rest, triangles, u_axis);
     if (!material) {
         // The per-spring form: springs.structural along u for an edge nearer u, along v otherwise.
         for (const EdgeUse& e : edges) {
@@ -324,7 +351,8 @@ std::string cloth_mesh_summary(const Topology& topology, std::size_t particles, 
     std::ostringstream out;
     out.precision(3);
     out << "mesh: " << particles << " vertices, " << edges << " edges (" << edges - std::min(edges, topology.hinges.size())
-        << " on the boundary), " << topology.triangles.size() << " triangles; shortest edge " << shortest << " m";
+        << " on the boundary), " << topology.triangles.size()
+        << (topology.membranes.empty() ? " triangles" : " membrane triangles") << "; shortest edge " << shortest << " m";
     if (critical_substep > 0.0 && std::isfinite(critical_substep)) out << "; critical substep " << 1e3 * critical_substep << " ms";
     return out.str();
 }

@@ -3,6 +3,7 @@
 #include "scene/cloth_shape.hpp"
 #include "clothsim/scene.hpp"
 #include "clothsim/cloth_mesh.hpp"
+#include "model/membrane.hpp"
 
 #include <array>
 #include <optional>
@@ -194,11 +195,11 @@ SpringConstants spring_constants(const ClothSettings& cloth, const MaterialSetti
     const double hu = h.x, hv = h.y;
     const double su = material.stretch.x, sv = material.stretch.y, g = material.shear;
     SpringConstants out;
-    // Uniaxial stiffness along u is C11 - G^2 / C22 and along v C22 - G^2 / C11 (C12 = G). Both equal to the
-    // targets: C11 C22 - G^2 = su C22 = sv C11, so C11 = r C22 with r = su / sv, and r C22^2 - su C22 - G^2 = 0.
-    const double r = su / sv;
-    const double c22 = (su + std::sqrt(su * su + 4.0 * r * g * g)) / (2.0 * r);
-    const double c11 = r * c22;
+    // Uniaxial stiffness along u is C11 - G^2 / C22 and along v C22 - G^2 / C11 (C12 = G), both the targets: the
+    // tensor a mesh cloth's membrane triangles take too (membrane.hpp).
+    const MembraneTensor tensor = membrane_tensor(su, sv, g);
+    const double c22 = tensor.c22;
+    const double c11 = tensor.c11;
     double au = c11 - g * (hu / hv) * (hu / hv);
     double av = c22 - g * (hv / hu) * (hv / hu);
     // On long thin cells the diagonals alone may be stiffer in tension along the short side than the stretch
@@ -230,6 +231,7 @@ void note_field_set(Scene& scene, std::string_view field) {
             m = MaterialSettings{};
             scene.settings.springs.stretch_curve = {};  // the per-spring form is linear
             scene.settings.springs.mesh_curve = {};
+            scene.settings.springs.membrane_curve = {};
         }
         return;
     }
@@ -265,7 +267,16 @@ void derive_springs(Scene& scene) {
         s.bending = scene.material.bending;
         // Its edges mix warp and weft: a curve per warp level (stretch_curve.hpp, mesh_curves).
         s.stretch_curve = {};
-        s.mesh_curve = mesh_curves(scene.material.stretch_curve, scene.material.stretch.x, scene.material.stretch.y);
+        if (scene.cloth.membrane == MembraneModel::Triangles) {
+            // The triangles' own directions: each curve on its tensor entry (C11 along u, C22 along v).
+            const MembraneTensor c = membrane_tensor(scene.material.stretch.x, scene.material.stretch.y, scene.material.shear);
+            s.mesh_curve = {};
+            s.membrane_curve = {spring_curve(scene.material.stretch_curve.u, scene.material.stretch.x, c.c11),
+                                spring_curve(scene.material.stretch_curve.v, scene.material.stretch.y, c.c22)};
+        } else {
+            s.mesh_curve = mesh_curves(scene.material.stretch_curve, scene.material.stretch.x, scene.material.stretch.y);
+            s.membrane_curve = {};
+        }
         double area = 0.0;
         if (scene.cloth.mesh_data) {
             for (double a : vertex_areas(placed_cloth_vertices(scene.cloth), scene.cloth.mesh_data->triangles())) area += a;
@@ -284,6 +295,7 @@ void derive_springs(Scene& scene) {
     s.stretch_curve = {spring_curve(scene.material.stretch_curve.u, scene.material.stretch.x, k.structural.x * h.x / h.y),
                        spring_curve(scene.material.stretch_curve.v, scene.material.stretch.y, k.structural.y * h.y / h.x)};
     s.mesh_curve = {};
+    s.membrane_curve = {};
     scene.cloth.mass = static_cast<float>(k.total_mass);
 }
 

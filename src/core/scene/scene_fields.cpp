@@ -39,6 +39,7 @@ const std::array kFields = {
     FieldInfo{"cloth.mesh", "", 0, 0, "a Wavefront OBJ file whose triangles are the cloth (beside the scene file, else a bundled mesh); \"\" = the rows x cols grid. Its vertices are the particles, pinned by index: pins = [{ vertex = 0 }]", [](Scene& s) -> FieldRef { return &s.cloth.mesh; }},
     FieldInfo{"cloth.mesh_rotation", "degrees", -360, 360, "a mesh cloth turned about x, then y, then z (then moved by cloth.origin)", [](Scene& s) -> FieldRef { return &s.cloth.mesh_rotation; }},
     FieldInfo{"cloth.mesh_scale", "", 1e-6, 1e4, "a mesh cloth's units to metres", [](Scene& s) -> FieldRef { return &s.cloth.mesh_scale; }},
+    FieldInfo{"cloth.membrane", "", 0, 0, "a mesh cloth's stretch and shear with [material]: springs (van Gelder's on the edges; shear follows stretch) or triangles (a constant-strain triangle each: the material's stretch and shear exactly, on any triangulation)", [](Scene& s) -> FieldRef { return &s.cloth.membrane; }},
     FieldInfo{"cloth.velocity", "m/s", -1e3, 1e3, "initial velocity of every free particle", [](Scene& s) -> FieldRef { return &s.cloth.velocity; }},
 
     FieldInfo{"material.enabled", "", 0, 0, "whether [material] describes the cloth (any other material field turns it on); false returns to the per-spring form, keeping the mass and spring constants derived on this grid", [](Scene& s) -> FieldRef { return &s.material.enabled; }},
@@ -102,6 +103,7 @@ constexpr std::array<std::string_view, kIntegrators.size()> kIntegratorNames = [
 }();
 constexpr std::array<std::string_view, 2> kContactModelNames = {"projection", "penalty"};
 constexpr std::array<std::string_view, 2> kClothShapeNames = {"rectangle", "disc"};
+constexpr std::array<std::string_view, 2> kMembraneModelNames = {"springs", "triangles"};
 
 // Shortest text that reads back to the same float (std::to_chars), so 0.2f prints as 0.2, not 0.200000003.
 std::string number(double v) {
@@ -140,6 +142,7 @@ std::span<const std::string_view> solver_method_names() { return kSolverMethodNa
 std::span<const std::string_view> integrator_names() { return kIntegratorNames; }
 std::span<const std::string_view> contact_model_names() { return kContactModelNames; }
 std::span<const std::string_view> cloth_shape_names() { return kClothShapeNames; }
+std::span<const std::string_view> membrane_model_names() { return kMembraneModelNames; }
 
 std::string describe_pin_radius() { return cat("a number in [0.0, ", number(kMaxPinRadius), "] m"); }
 
@@ -311,6 +314,10 @@ void validate(const Scene& scene) {
     }
     if (const std::string clash = material_clash(scene); !clash.empty()) throw SceneError(clash);
     if (scene.material.enabled && !c.is_mesh()) spring_constants(scene.cloth, scene.material);  // throws what it cannot derive
+    if (c.membrane == MembraneModel::Triangles && c.is_mesh() && !scene.material.enabled) {
+        throw SceneError("cloth.membrane = \"triangles\" takes the membrane's tensor from [material]; allowed without "
+                         "[material] (per-spring values): \"springs\"");
+    }
     if (scene.material.enabled) {
         const StretchCurve& curve = scene.material.stretch_curve;
         for (const auto& [axis, samples] : {std::pair{"u", &curve.u}, std::pair{"v", &curve.v}}) {
@@ -318,7 +325,8 @@ void validate(const Scene& scene) {
                 throw SceneError(cat("material.stretch_curve.", axis, ": ", problem));
             }
         }
-        if (const std::string problem = c.is_mesh() ? mesh_curve_problem(curve) : ""; !problem.empty()) {
+        const bool blended = c.is_mesh() && c.membrane == MembraneModel::Springs;  // the edge springs' blends
+        if (const std::string problem = blended ? mesh_curve_problem(curve) : ""; !problem.empty()) {
             throw SceneError("material.stretch_curve: " + problem + " (docs/MATERIAL.md, \"Nonlinear stretch\")");
         }
     }

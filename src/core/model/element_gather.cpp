@@ -25,7 +25,9 @@ static_assert(kPiece % kLanes == 0);
 
 ElementGather ElementGather::for_topology(const Topology& topology) {
     ElementGather g;
-    g.springs = topology.springs.size();
+    // A cloth of membrane triangles has edge springs of weight 0, which no live change gives stiffness
+    // (apply_fabric): they add nothing, and the gather leaves them out.
+    g.springs = topology.membranes.empty() ? topology.springs.size() : 0;
     g.hinges = topology.hinges.size();
     g.membranes = topology.membranes.size();
     const std::size_t n = static_cast<std::size_t>(topology.rows) * static_cast<std::size_t>(topology.cols);
@@ -57,7 +59,8 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
         g.coefficient[fill[particle]++] = c;
     });
     g.element_force.resize(g.springs + g.hinges + 2 * g.membranes);
-    for (const Spring& sp : topology.springs) {
+    for (std::size_t j = 0; j < g.springs; ++j) {
+        const Spring& sp = topology.springs[j];
         g.spring_a.push_back(static_cast<std::int32_t>(sp.a));
         g.spring_b.push_back(static_cast<std::int32_t>(sp.b));
         g.spring_rest.push_back(sp.rest_length);
@@ -72,6 +75,14 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
         for (std::size_t k = 0; k < 3; ++k) g.hinge_c[k].push_back(h.c[k + 1]);
         g.hinge_weight_u.push_back(h.weight_u);
         g.hinge_weight_v.push_back(h.weight_v);
+    }
+    for (const Membrane& m : topology.membranes) {
+        for (std::size_t k = 0; k < 3; ++k) g.membrane_v[k].push_back(static_cast<std::int32_t>(m.v[k]));
+        g.membrane_b[0].push_back(m.bu[1]);
+        g.membrane_b[1].push_back(m.bu[2]);
+        g.membrane_b[2].push_back(m.bv[1]);
+        g.membrane_b[3].push_back(m.bv[2]);
+        g.membrane_area.push_back(m.area);
     }
     // The lane layout: block b holds particles 16 b .. 16 b + 15, padded to its longest list.
     const std::size_t blocks = (n + kLanes - 1) / kLanes;
@@ -177,6 +188,65 @@ CLOTHSIM_AVX512 void hinges_avx512(ElementGather& g, const DVec3Array& position,
     }
 }
 
+// (x x + y y) + z z of eight vectors, glm::dot's order.
+CLOTHSIM_AVX512 inline __m512d dot8(const __m512d* x, const __m512d* y) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(x[0], y[0]), _mm512_mul_pd(x[1], y[1])), _mm512_mul_pd(x[2], y[2]));
+}
+
+// Membranes [first, last) eight at a time, linear ones (no stretch curve), with membrane_forces' double
+// operations in its order (membrane.hpp): w = b_1 (x_1 - x_0) + b_2 (x_2 - x_0), q = (x x + y y) + z z, |w| its
+// square root, e = (q - 1) / (|w| + 1), the stresses, p = -A ((sigma / |w|) w + tau w'), each rounded once to float;
+// a collapsed triangle's p_u and p_v 0. p_u and p_v go to the slots base + 2 m and the next, interleaved.
+CLOTHSIM_AVX512 void membranes_avx512(ElementGather& g, const DVec3Array& position, const MembraneTensor& c,
+                                      std::size_t first, std::size_t last) {
+    const double* p[3] = {position.x.data(), position.y.data(), position.z.data()};
+    float* out[3] = {g.element_force.x.data(), g.element_force.y.data(), g.element_force.z.data()};
+    const __m512d one = _mm512_set1_pd(1.0), zero = _mm512_setzero_pd(), tiny = _mm512_set1_pd(1e-12);
+    const __m512d c11 = _mm512_set1_pd(c.c11), c22 = _mm512_set1_pd(c.c22), c12 = _mm512_set1_pd(c.c12), c66 = _mm512_set1_pd(c.c66);
+    // p_u lane l to 2 l, p_v lane l to 2 l + 1: lanes 0-3 in the low run, 4-7 in the high one.
+    const __m512i low = _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11), high = _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15);
+    const std::size_t base = g.springs + g.hinges;
+    for (std::size_t m = first; m < last; m += 8) {
+        const std::size_t count = std::min<std::size_t>(8, last - m);
+        const __mmask8 live = static_cast<__mmask8>((1u << count) - 1u);
+        const __mmask16 pairs = static_cast<__mmask16>((1u << (2 * count)) - 1u);
+        __m256i v[3];
+        for (std::size_t k = 0; k < 3; ++k) v[k] = _mm256_maskz_loadu_epi32(live, &g.membrane_v[k][m]);
+        __m512d b[4];
+        for (std::size_t k = 0; k < 4; ++k) b[k] = _mm512_maskz_cvtps_pd(__mmask8(0xFF), _mm256_maskz_loadu_ps(live, &g.membrane_b[k][m]));
+        const __m512d area = _mm512_maskz_cvtps_pd(__mmask8(0xFF), _mm256_maskz_loadu_ps(live, &g.membrane_area[m]));
+        __m512d wu[3], wv[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            const __m512d o = _mm512_mask_i32gather_pd(zero, live, v[0], p[axis], 8);
+            const __m512d d1 = _mm512_sub_pd(_mm512_mask_i32gather_pd(zero, live, v[1], p[axis], 8), o);
+            const __m512d d2 = _mm512_sub_pd(_mm512_mask_i32gather_pd(zero, live, v[2], p[axis], 8), o);
+            wu[axis] = _mm512_add_pd(_mm512_mul_pd(b[0], d1), _mm512_mul_pd(b[1], d2));
+            wv[axis] = _mm512_add_pd(_mm512_mul_pd(b[2], d1), _mm512_mul_pd(b[3], d2));
+        }
+        const __m512d qu = dot8(wu, wu), qv = dot8(wv, wv);
+        const __m512d lu = _mm512_maskz_sqrt_pd(__mmask8(0xFF), qu), lv = _mm512_maskz_sqrt_pd(__mmask8(0xFF), qv);
+        const __mmask8 valid = live & _mm512_cmp_pd_mask(lu, tiny, _CMP_GT_OQ) & _mm512_cmp_pd_mask(lv, tiny, _CMP_GT_OQ);
+        const __m512d eu = _mm512_div_pd(_mm512_sub_pd(qu, one), _mm512_add_pd(lu, one));
+        const __m512d ev = _mm512_div_pd(_mm512_sub_pd(qv, one), _mm512_add_pd(lv, one));
+        const __m512d gamma = dot8(wu, wv);
+        const __m512d sigma_u = _mm512_add_pd(_mm512_mul_pd(c11, eu), _mm512_mul_pd(c12, ev));
+        const __m512d sigma_v = _mm512_add_pd(_mm512_mul_pd(c22, ev), _mm512_mul_pd(c12, eu));
+        const __m512d tau = _mm512_mul_pd(c66, gamma);
+        const __m512d a = _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(area), _mm512_set1_epi64(INT64_MIN)));  // -A
+        const __m512d su = _mm512_maskz_div_pd(valid, sigma_u, lu), sv = _mm512_maskz_div_pd(valid, sigma_v, lv);
+        for (int axis = 0; axis < 3; ++axis) {
+            const __m512d pu = _mm512_mul_pd(a, _mm512_add_pd(_mm512_mul_pd(su, wu[axis]), _mm512_mul_pd(tau, wv[axis])));
+            const __m512d pv = _mm512_mul_pd(a, _mm512_add_pd(_mm512_mul_pd(sv, wv[axis]), _mm512_mul_pd(tau, wu[axis])));
+            // Interleaved in double (p_u of lane l at 2 l, p_v at 2 l + 1), then rounded: two runs of eight floats.
+            const __m512d u = _mm512_maskz_mov_pd(valid, pu), w = _mm512_maskz_mov_pd(valid, pv);
+            const __m256 lo = _mm512_maskz_cvtpd_ps(__mmask8(0xFF), _mm512_permutex2var_pd(u, low, w));
+            const __m256 hi = _mm512_maskz_cvtpd_ps(__mmask8(0xFF), _mm512_permutex2var_pd(u, high, w));
+            _mm256_mask_storeu_ps(out[axis] + base + 2 * m, static_cast<__mmask8>(pairs & 0xFF), lo);
+            _mm256_mask_storeu_ps(out[axis] + base + 2 * m + 8, static_cast<__mmask8>(pairs >> 8), hi);
+        }
+    }
+}
+
 }  // namespace
 
 // Particles [first, last) (whole blocks of kLanes, the last one maybe short) add their terms, sixteen at a time
@@ -250,6 +320,10 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
             const std::size_t first = static_cast<std::size_t>(piece - spring_pieces - hinge_pieces) * kPiece;
             const std::size_t last = std::min(g.membranes, first + kPiece);
             const std::size_t base = g.springs + g.hinges;
+            if (wide && springs.membrane_curve[0].knots == 0 && springs.membrane_curve[1].knots == 0) {
+                membranes_avx512(g, position, tensor, first, last);
+                return;
+            }
             for (std::size_t m = first; m < last; ++m) {
                 Vec pu(0.0f), pv(0.0f);
                 if (!membrane_forces(position, topology.membranes[m], tensor, springs, pu, pv)) pu = pv = Vec(0.0f);

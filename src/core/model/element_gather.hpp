@@ -37,6 +37,11 @@ struct ElementGather {
     std::array<std::vector<std::int32_t>, 4> hinge_v;
     std::array<std::vector<float>, 3> hinge_c;
     std::vector<float> hinge_weight_u, hinge_weight_v;
+    // A membrane's three particles, its weights bu_1, bu_2, bv_1, bv_2 (bu_0 and bv_0 multiply no difference) and
+    // rest area.
+    std::array<std::vector<std::int32_t>, 3> membrane_v;
+    std::array<std::vector<float>, 4> membrane_b;
+    std::vector<float> membrane_area;
     // The same terms for the AVX-512 sum, sixteen particles a block, one lane each: block b's term t of lane l
     // is at lanes_begin[b] + 16 t + l, for t below the lane's count (lane_terms); the rest are padding.
     std::vector<std::uint32_t> lanes_begin, lane_source, lane_terms;

@@ -113,6 +113,8 @@ std::string spring_note(const StepPlan& plan, const Topology& topology) {
         }
     }
     if (runs.empty()) runs = "no spring kind";
+    // A mesh cloth's constant-strain triangles carry its stretch and shear (its edge springs have weight 0).
+    if (!topology.membranes.empty()) runs = "membrane triangles; " + runs;
     return skipped.empty() ? runs : runs.append(" (skipped ").append(skipped).append(")");
 }
 

@@ -280,7 +280,7 @@ bool field_row(Scene& edit, AppState& app, const FieldInfo& f) {
     // A mesh cloth does not read the grid's fields, nor a grid the mesh's placement.
     const bool grid_field = f.name == "cloth.rows" || f.name == "cloth.cols" || f.name == "cloth.size" ||
                             f.name == "cloth.shape" || f.name == "cloth.v_axis";
-    const bool mesh_field = f.name == "cloth.mesh_rotation" || f.name == "cloth.mesh_scale";
+    const bool mesh_field = f.name == "cloth.mesh_rotation" || f.name == "cloth.mesh_scale" || f.name == "cloth.membrane";
     const bool unread = edit.cloth.is_mesh() ? grid_field : mesh_field;
     bool changed = false;
     if (owned) ImGui::BeginDisabled();

@@ -82,5 +82,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (float m : sim.state().mass) {
         if (!(std::isfinite(m) && m > 0.0f)) fuzz::fail("a cloth mesh's particle has a mass that is not finite and positive");
     }
+    // As constant-strain triangles: one per triangle, with finite weights and a positive area.
+    scene.cloth.membrane = MembraneModel::Triangles;
+    const MassSpring triangles = build_simulation(scene);  // the same checks passed above
+    if (triangles.topology().membranes.size() != triangles.topology().triangles.size()) fuzz::fail("a triangle without its membrane");
+    for (const Membrane& m : triangles.topology().membranes) {
+        for (int i = 0; i < 3; ++i) {
+            if (!(std::isfinite(m.bu[i]) && std::isfinite(m.bv[i]))) fuzz::fail("a membrane triangle's weight is not finite");
+        }
+        if (!(std::isfinite(m.area) && m.area > 0.0f)) fuzz::fail("a membrane triangle's area is not finite and positive");
+    }
     return 0;
 }

@@ -429,7 +429,7 @@ double strip_stretch(const Mesh& mesh, double length, double width, glm::vec2 st
         int left = 0;
         for (std::uint32_t i : t.v) left += coordinate(m.vertices[i]) < length / 2;
         if (left == 0 || left == 3) continue;
-        glm::dvec3 pu, pv;
+        glm::dvec3 pu(0.0), pv(0.0);
         if (!membrane_forces(state.position, t, tensor, sim.settings().springs, pu, pv)) continue;
         for (int i = 0; i < 3; ++i) {
             if (coordinate(m.vertices[t.v[i]]) < length / 2) tension += coordinate(double(t.bu[i]) * pu + double(t.bv[i]) * pv);

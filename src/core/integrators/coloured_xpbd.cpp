@@ -209,6 +209,116 @@ __attribute__((target("avx512f,avx512vl,avx2,fma"))) double ColouredXpbd::hinges
     return violation;
 }
 
+// (x x + y y) + z z, glm::dot's order.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static inline __m512d dot8(const __m512d* a, const __m512d* b) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a[0], b[0]), _mm512_mul_pd(a[1], b[1])), _mm512_mul_pd(a[2], b[2]));
+}
+
+// ((w_0 a_0) b_0 + (w_1 a_1) b_1) + (w_2 a_2) b_2.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static inline __m512d weighted_sum3(const __m512d* w, const __m512d* a,
+                                                                                        const __m512d* b) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_mul_pd(w[0], a[0]), b[0]), _mm512_mul_pd(_mm512_mul_pd(w[1], a[1]), b[1])),
+                         _mm512_mul_pd(_mm512_mul_pd(w[2], a[2]), b[2]));
+}
+// a b - c d.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static inline __m512d products_difference(__m512d a, __m512d b, __m512d c, __m512d d) {
+    return _mm512_sub_pd(_mm512_mul_pd(a, b), _mm512_mul_pd(c, d));
+}
+// -((r_0 c_0 + r_1 c_1) + r_2 c_2) / det.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) static inline __m512d adjugate_row_solve(
+    __m512d r0, __m512d r1, __m512d r2, __m512d c0, __m512d c1, __m512d c2, __m512d det) {
+    return _mm512_div_pd(negate(_mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(r0, c0), _mm512_mul_pd(r1, c1)), _mm512_mul_pd(r2, c2))), det);
+}
+
+// project_membrane (xpbd_projection.hpp) eight at a time, for a linear material with shear (C66 > 0): every
+// operation of the scalar form in its order; a collapsed triangle (|w| <= 1e-12) or a compliance that is not
+// positive is left alone, as there.
+__attribute__((target("avx512f,avx512vl,avx2,fma"))) double ColouredXpbd::membranes_avx512(
+    State& state, const Topology& topology, const SpringSettings& springs, std::uint32_t begin, std::uint32_t end,
+    const MembraneTensor& c, double h, XpbdMultipliers& multipliers) const {
+    const MembraneData& d = membrane_data_;
+    double* p[3] = {state.position.x.data(), state.position.y.data(), state.position.z.data()};
+    const float* inverse_mass = state.inverse_mass.data();
+    glm::dvec3* lambdas = multipliers.membrane.data();
+    const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0), two = _mm512_set1_pd(2.0),
+                  tiny = _mm512_set1_pd(1e-12), h2 = _mm512_set1_pd(h * h);
+    const __m512d c11 = _mm512_set1_pd(c.c11), c22 = _mm512_set1_pd(c.c22), c12 = _mm512_set1_pd(c.c12), c66 = _mm512_set1_pd(c.c66);
+    double violation = 0.0;
+    std::uint32_t e = begin;
+    for (; e + 8 <= end; e += 8) {
+        __m256i vi[3];
+        __m512d x[3][3], w[3], bu[3], bv[3];  // x[corner][axis]
+        for (int i = 0; i < 3; ++i) {
+            vi[i] = load8(d.v[static_cast<std::size_t>(i)].data() + e);
+            for (int k = 0; k < 3; ++k) x[i][k] = gather(p[k], vi[i]);
+            w[i] = gather_wide(inverse_mass, vi[i]);
+            bu[i] = _mm512_loadu_pd(d.bu[static_cast<std::size_t>(i)].data() + e);
+            bv[i] = _mm512_loadu_pd(d.bv[static_cast<std::size_t>(i)].data() + e);
+        }
+        const __m512d area = _mm512_loadu_pd(d.area.data() + e);
+        // membrane_strain: w = b_1 (x_1 - x_0) + b_2 (x_2 - x_0), e = (q - 1) / (|w| + 1), gamma = w_u . w_v.
+        __m512d wu[3], wv[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m512d d1 = _mm512_sub_pd(x[1][k], x[0][k]), d2 = _mm512_sub_pd(x[2][k], x[0][k]);
+            wu[k] = _mm512_add_pd(_mm512_mul_pd(bu[1], d1), _mm512_mul_pd(bu[2], d2));
+            wv[k] = _mm512_add_pd(_mm512_mul_pd(bv[1], d1), _mm512_mul_pd(bv[2], d2));
+        }
+        const __m512d qu = dot8(wu, wu), qv = dot8(wv, wv);
+        const __m512d lu = _mm512_maskz_sqrt_pd(0xFF, qu), lv = _mm512_maskz_sqrt_pd(0xFF, qv);
+        const __m512d eu = _mm512_div_pd(_mm512_sub_pd(qu, one), _mm512_add_pd(lu, one));
+        const __m512d ev = _mm512_div_pd(_mm512_sub_pd(qv, one), _mm512_add_pd(lv, one));
+        const __m512d gamma = dot8(wu, wv);
+        // membrane_compliance, linear: K = A [[C11, C12], [C12, C22]], alpha~ = K^-1 / h^2; shear 1 / (A C66 h^2).
+        const __m512d k11 = _mm512_mul_pd(area, c11), k22 = _mm512_mul_pd(area, c22), k12 = _mm512_mul_pd(area, c12);
+        const __m512d kdet = _mm512_sub_pd(_mm512_mul_pd(k11, k22), _mm512_mul_pd(k12, k12));
+        const __mmask8 on = _mm512_cmp_pd_mask(lu, tiny, _CMP_GT_OQ) & _mm512_cmp_pd_mask(lv, tiny, _CMP_GT_OQ) &
+                            _mm512_cmp_pd_mask(k11, zero, _CMP_GT_OQ) & _mm512_cmp_pd_mask(k22, zero, _CMP_GT_OQ) &
+                            _mm512_cmp_pd_mask(kdet, zero, _CMP_GT_OQ);
+        const __m512d dh = _mm512_mul_pd(kdet, h2);
+        const __m512d al00 = _mm512_div_pd(k22, dh), al11 = _mm512_div_pd(k11, dh), al01 = _mm512_div_pd(negate(k12), dh);
+        const __m512d al22 = _mm512_div_pd(one, _mm512_mul_pd(_mm512_mul_pd(area, c66), h2));
+        __m512d nu[3], nv[3];
+        for (int k = 0; k < 3; ++k) nu[k] = _mm512_div_pd(wu[k], lu), nv[k] = _mm512_div_pd(wv[k], lv);
+        const __m512d suu = weighted_sum3(w, bu, bu), svv = weighted_sum3(w, bv, bv), suv = weighted_sum3(w, bu, bv);
+        const __m512d a00 = _mm512_add_pd(al00, _mm512_mul_pd(suu, dot8(nu, nu)));
+        const __m512d a11 = _mm512_add_pd(al11, _mm512_mul_pd(svv, dot8(nv, nv)));
+        const __m512d a01 = _mm512_add_pd(al01, _mm512_mul_pd(suv, dot8(nu, nv)));
+        const __m512d a02 = _mm512_add_pd(_mm512_mul_pd(suu, dot8(nu, wv)), _mm512_mul_pd(suv, dot8(nu, wu)));
+        const __m512d a12 = _mm512_add_pd(_mm512_mul_pd(suv, dot8(nv, wv)), _mm512_mul_pd(svv, dot8(nv, wu)));
+        const __m512d a22 = _mm512_add_pd(_mm512_add_pd(al22, _mm512_add_pd(_mm512_mul_pd(suu, dot8(wv, wv)),
+                                                                             _mm512_mul_pd(_mm512_mul_pd(two, suv), gamma))),
+                                          _mm512_mul_pd(svv, dot8(wu, wu)));
+        const __m512d m00 = products_difference(a11, a22, a12, a12), m01 = products_difference(a02, a12, a01, a22), m02 = products_difference(a01, a12, a02, a11);
+        const __m512d m11 = products_difference(a00, a22, a02, a02), m12 = products_difference(a01, a02, a00, a12), m22 = products_difference(a00, a11, a01, a01);
+        const __m512d det = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a00, m00), _mm512_mul_pd(a01, m01)), _mm512_mul_pd(a02, m02));
+        const __m512d l0 = adjugate_row_solve(m00, m01, m02, eu, ev, gamma, det);
+        const __m512d l1 = adjugate_row_solve(m01, m11, m12, eu, ev, gamma, det);
+        const __m512d l2 = adjugate_row_solve(m02, m12, m22, eu, ev, gamma, det);
+        for (int k = 0; k < 3; ++k) {
+            const __m512d P = _mm512_add_pd(_mm512_mul_pd(l0, nu[k]), _mm512_mul_pd(l2, wv[k]));
+            const __m512d Q = _mm512_add_pd(_mm512_mul_pd(l1, nv[k]), _mm512_mul_pd(l2, wu[k]));
+            for (int i = 0; i < 3; ++i) {
+                const __m512d moved = _mm512_add_pd(x[i][k], _mm512_add_pd(_mm512_mul_pd(_mm512_mul_pd(w[i], bu[i]), P),
+                                                                           _mm512_mul_pd(_mm512_mul_pd(w[i], bv[i]), Q)));
+                _mm512_mask_i32scatter_pd(p[k], on, vi[i], moved, 8);
+            }
+        }
+        alignas(64) double o0[8], o1[8], o2[8], cc[8];
+        _mm512_store_pd(o0, l0), _mm512_store_pd(o1, l1), _mm512_store_pd(o2, l2);
+        _mm512_store_pd(cc, _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(eu, eu), _mm512_mul_pd(ev, ev)), _mm512_mul_pd(gamma, gamma)));
+        for (int l = 0; l < 8; ++l) {
+            const bool projected = on & (1u << l);
+            lambdas[membranes_.order[e + static_cast<std::uint32_t>(l)]] = projected ? glm::dvec3(o0[l], o1[l], o2[l]) : glm::dvec3(0.0);
+            if (projected) violation += cc[l];
+        }
+    }
+    for (; e < end; ++e) {
+        const std::uint32_t j = membranes_.order[e];
+        violation += project_membrane(state, topology.membranes[j], c, springs, h, multipliers.membrane[j]);
+    }
+    return violation;
+}
+
 std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology) {
     std::size_t n = 0;  // the particles the elements reach
     for (const Spring& s : topology.springs) n = std::max<std::size_t>(n, std::max(s.a, s.b) + std::size_t{1});
@@ -244,6 +354,16 @@ std::optional<ColouredXpbd> ColouredXpbd::for_topology(const Topology& topology)
             hd.v[static_cast<std::size_t>(i)].push_back(static_cast<std::int32_t>(topology.hinges[j].v[static_cast<std::size_t>(i)]));
             hd.c[static_cast<std::size_t>(i)].push_back(double(topology.hinges[j].c[static_cast<std::size_t>(i)]));
         }
+    }
+    MembraneData& md = out.membrane_data_;
+    for (std::uint32_t j : out.membranes_.order) {
+        const Membrane& m = topology.membranes[j];
+        for (std::size_t i = 0; i < 3; ++i) {
+            md.v[i].push_back(static_cast<std::int32_t>(m.v[i]));
+            md.bu[i].push_back(double(m.bu[i]));
+            md.bv[i].push_back(double(m.bv[i]));
+        }
+        md.area.push_back(double(m.area));
     }
     return out;
 }
@@ -347,7 +467,11 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
         return v;
     });
     const MembraneTensor tensor = membrane_tensor(springs);
-    project(membranes_, [&](std::uint32_t begin, std::uint32_t end) {  // a mesh cloth's triangles, in the scalar order
+    // A linear membrane with shear, eight at a time with AVX-512 (the same bits as project_membrane).
+    const bool wide_membranes = wide && springs.membrane_curve[0].knots == 0 && springs.membrane_curve[1].knots == 0 &&
+                                tensor.c66 > 0.0;
+    project(membranes_, [&](std::uint32_t begin, std::uint32_t end) {  // a mesh cloth's triangles
+        if (wide_membranes) return membranes_avx512(state, topology, springs, begin, end, tensor, h, multipliers);
         double v = 0.0;
         for (std::uint32_t e = begin; e < end; ++e) {
             const std::uint32_t j = membranes_.order[e];

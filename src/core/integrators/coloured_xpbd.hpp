@@ -17,6 +17,7 @@
 
 #include "integrators/integrators.hpp"
 #include "integrators/team_choice.hpp"
+#include "model/membrane.hpp"
 
 #include <array>
 #include <cstdint>
@@ -66,6 +67,8 @@ private:
     double hinge_one(State& state, std::uint32_t e, XpbdMultipliers& multipliers) const;
     double springs_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
     double hinges_avx512(State& state, std::uint32_t begin, std::uint32_t end, XpbdMultipliers& multipliers) const;
+    double membranes_avx512(State& state, const Topology& topology, const SpringSettings& springs, std::uint32_t begin,
+                            std::uint32_t end, const MembraneTensor& c, double h, XpbdMultipliers& multipliers) const;
 
     Colours springs_, bends_, hinges_, membranes_;
     // The springs' and hinges' data in colour order (entry e is element order[e]), what a colour's pass reads
@@ -80,6 +83,12 @@ private:
         std::array<std::vector<double>, 4> c;
         std::vector<double> k, alpha;
     } hinge_data_;
+    // The membranes' data in colour order: corners, weights and rest areas, in double.
+    struct MembraneData {
+        std::array<std::vector<std::int32_t>, 3> v;
+        std::array<std::vector<double>, 3> bu, bv;
+        std::vector<double> area;
+    } membrane_data_;
     double alpha_h_ = 0.0;  // the substep alpha is for (0: not set)
     DVec3Array a_, start_;
     Vec3Array wind_;

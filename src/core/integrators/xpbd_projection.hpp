@@ -11,7 +11,6 @@
 #include "model/membrane.hpp"
 
 #include <glm/mat3x3.hpp>
-#include <glm/matrix.hpp>
 
 #include <array>
 #include <cmath>
@@ -110,6 +109,11 @@ inline bool membrane_compliance(const MembraneTensor& c, const SpringSettings& s
     return true;
 }
 
+// The block's matrix J W J^T + alpha~ in sums over the corners: with S_uu = sum_i w_i bu_i^2, S_vv, S_uv likewise,
+// n = w / |w|, its entries are alpha~ plus S_uu n_u.n_u, S_vv n_v.n_v, S_uv n_u.n_v, S_uu n_u.w_v + S_uv n_u.w_u,
+// S_uv n_v.w_v + S_vv n_v.w_u and S_uu w_v.w_v + 2 S_uv w_u.w_v + S_vv w_u.w_u; it is solved by its adjugate,
+// and corner i moves by (w_i bu_i) P + (w_i bv_i) Q, P = l_0 n_u + l_2 w_v, Q = l_1 n_v + l_2 w_u. ColouredXpbd's
+// AVX-512 pass does these operations in this order (the same bits).
 inline double project_membrane(State& state, const Membrane& m, const MembraneTensor& c, const SpringSettings& springs,
                                double h, glm::dvec3& lambda) {
     lambda = glm::dvec3(0.0);
@@ -118,29 +122,30 @@ inline double project_membrane(State& state, const Membrane& m, const MembraneTe
     glm::dmat3 alpha;
     if (!membrane_compliance(c, springs, s, double(m.area), h * h, alpha)) return 0.0;
     const bool shear = alpha[2][2] > 0.0;
-    // Each corner's gradients: bu_i n_u, bv_i n_v and bu_i w_v + bv_i w_u.
     const glm::dvec3 nu = s.wu / s.lu, nv = s.wv / s.lv;
-    std::array<std::array<glm::dvec3, 3>, 3> grad;
-    std::array<double, 3> w;
-    for (int i = 0; i < 3; ++i) {
-        w[i] = double(state.inverse_mass[m.v[i]]);
-        const double bu = double(m.bu[i]), bv = double(m.bv[i]);
-        grad[i] = {bu * nu, bv * nv, shear ? bu * s.wv + bv * s.wu : glm::dvec3(0.0)};
-    }
-    glm::dmat3 a = alpha;  // J W J^T + alpha~ (column-major; symmetric)
-    for (int p = 0; p < 3; ++p) {
-        for (int q = 0; q < 3; ++q) {
-            for (int i = 0; i < 3; ++i) a[q][p] += w[i] * glm::dot(grad[i][p], grad[i][q]);
-        }
-    }
-    if (!shear) a[2][2] = 1.0;  // d_lambda_gamma = 0
-    const glm::dvec3 C(s.eu, s.ev, shear ? s.gamma : 0.0);
-    lambda = glm::inverse(a) * -C;
-    for (int i = 0; i < 3; ++i) {
-        if (w[i] == 0.0) continue;
-        state.position.add(m.v[i], w[i] * (lambda.x * grad[i][0] + lambda.y * grad[i][1] + lambda.z * grad[i][2]));
-    }
-    return glm::dot(C, C);
+    double w[3], bu[3], bv[3];
+    for (int i = 0; i < 3; ++i) w[i] = double(state.inverse_mass[m.v[i]]), bu[i] = double(m.bu[i]), bv[i] = double(m.bv[i]);
+    const double suu = ((w[0] * bu[0]) * bu[0] + (w[1] * bu[1]) * bu[1]) + (w[2] * bu[2]) * bu[2];
+    const double svv = ((w[0] * bv[0]) * bv[0] + (w[1] * bv[1]) * bv[1]) + (w[2] * bv[2]) * bv[2];
+    const double suv = ((w[0] * bu[0]) * bv[0] + (w[1] * bu[1]) * bv[1]) + (w[2] * bu[2]) * bv[2];
+    const double a00 = alpha[0][0] + suu * glm::dot(nu, nu);
+    const double a11 = alpha[1][1] + svv * glm::dot(nv, nv);
+    const double a01 = alpha[0][1] + suv * glm::dot(nu, nv);
+    const double a02 = shear ? suu * glm::dot(nu, s.wv) + suv * glm::dot(nu, s.wu) : 0.0;
+    const double a12 = shear ? suv * glm::dot(nv, s.wv) + svv * glm::dot(nv, s.wu) : 0.0;
+    const double a22 = shear ? (alpha[2][2] + (suu * glm::dot(s.wv, s.wv) + 2.0 * suv * s.gamma)) + svv * glm::dot(s.wu, s.wu) : 1.0;
+    const double c0 = s.eu, c1 = s.ev, c2 = shear ? s.gamma : 0.0;
+    // The adjugate's rows (symmetric) and the determinant by the first row.
+    const double m00 = a11 * a22 - a12 * a12, m01 = a02 * a12 - a01 * a22, m02 = a01 * a12 - a02 * a11;
+    const double m11 = a00 * a22 - a02 * a02, m12 = a01 * a02 - a00 * a12, m22 = a00 * a11 - a01 * a01;
+    const double det = (a00 * m00 + a01 * m01) + a02 * m02;
+    const double l0 = -((m00 * c0 + m01 * c1) + m02 * c2) / det;
+    const double l1 = -((m01 * c0 + m11 * c1) + m12 * c2) / det;
+    const double l2 = -((m02 * c0 + m12 * c1) + m22 * c2) / det;
+    lambda = glm::dvec3(l0, l1, l2);
+    const glm::dvec3 P = l0 * nu + l2 * s.wv, Q = l1 * nv + l2 * s.wu;
+    for (int i = 0; i < 3; ++i) state.position.add(m.v[i], (w[i] * bu[i]) * P + (w[i] * bv[i]) * Q);
+    return (c0 * c0 + c1 * c1) + c2 * c2;
 }
 
 // A membrane's residual C + alpha~ lambda at `position` (3 components).

@@ -444,13 +444,16 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
     };
     // A cloth of membrane triangles has edge springs of weight 0, which the list path skips one by one: none
     // is projected, their multipliers stay 0.
-    if (!topology.membranes.empty()) multipliers.spring.assign(topology.springs.size(), 0.0);
-    if (topology.membranes.empty()) project(springs_, [&](std::uint32_t begin, std::uint32_t end) {
-        if (wide && spring_data_.curve.empty()) return springs_avx512(state, begin, end, multipliers);
-        double v = 0.0;
-        for (std::uint32_t e = begin; e < end; ++e) v += spring_one(state, e, multipliers);
-        return v;
-    });
+    if (!topology.membranes.empty()) {
+        multipliers.spring.assign(topology.springs.size(), 0.0);
+    } else {
+        project(springs_, [&](std::uint32_t begin, std::uint32_t end) {
+            if (wide && spring_data_.curve.empty()) return springs_avx512(state, begin, end, multipliers);
+            double v = 0.0;
+            for (std::uint32_t e = begin; e < end; ++e) v += spring_one(state, e, multipliers);
+            return v;
+        });
+    }
     project(bends_, [&](std::uint32_t begin, std::uint32_t end) {  // a grid's: a mesh cloth has none
         double v = 0.0;
         for (std::uint32_t e = begin; e < end; ++e) {

@@ -312,11 +312,12 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
         if (!topology.membranes.empty()) {
             const MembraneTensor tensor = membrane_tensor(springs);
             for (const Membrane& m : topology.membranes) {
-                e += membrane_energy(position, m, tensor, springs);
+                const MembraneStrain s = membrane_strain(position, m, tensor, springs);  // once: energy, force, b
+                e += membrane_energy(s, double(m.area), tensor, springs);
                 glm::dvec3 pu(0.0), pv(0.0);
-                membrane_forces(position, m, tensor, springs, pu, pv);
-                const glm::dvec3 qu = double(m.area) * tensor.c11 * membrane_direction(position, m, m.bu) + pu;
-                const glm::dvec3 qv = double(m.area) * tensor.c22 * membrane_direction(position, m, m.bv) + pv;
+                if (s.valid) membrane_forces(s, double(m.area), pu, pv);
+                const glm::dvec3 qu = double(m.area) * tensor.c11 * s.wu + pu;
+                const glm::dvec3 qv = double(m.area) * tensor.c22 * s.wv + pv;
                 for (int i = 0; i < 3; ++i) {
                     const int r = f.free_index[m.v[i]];
                     if (r < 0) continue;

@@ -325,8 +325,8 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
                 return;
             }
             for (std::size_t m = first; m < last; ++m) {
-                Vec pu(0.0f), pv(0.0f);
-                if (!membrane_forces(position, topology.membranes[m], tensor, springs, pu, pv)) pu = pv = Vec(0.0f);
+                Vec pu(0.0f), pv(0.0f);  // left 0 for a collapsed triangle
+                membrane_forces(position, topology.membranes[m], tensor, springs, pu, pv);
                 g.element_force.set(base + 2 * m, pu);
                 g.element_force.set(base + 2 * m + 1, pv);
             }

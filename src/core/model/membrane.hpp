@@ -6,6 +6,8 @@
 #include "clothsim/settings.hpp"
 #include "clothsim/state.hpp"
 
+#include "model/forces.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <cmath>
@@ -72,27 +74,33 @@ inline MembraneStrain membrane_strain(const DVec3Array& position, const Membrane
 // d e_u / d x_i = bu_i w_u / |w_u|, d gamma / d x_i = bu_i w_v + bv_i w_u), with
 // p_u = -A (sigma_u w_u / |w_u| + tau w_v) and p_v = -A (sigma_v w_v / |w_v| + tau w_u), computed in double
 // and rounded once to the force type T. Every force path adds bu_i p_u, then bv_i p_v, to corner i.
+// From a valid strain s of a membrane of rest area `area`.
+template <class T>
+inline void membrane_forces(const MembraneStrain& s, double area, glm::vec<3, T>& pu, glm::vec<3, T>& pv) {
+    const double a = -area;
+    pu = glm::vec<3, T>(a * ((s.sigma_u / s.lu) * s.wu + s.tau * s.wv));
+    pv = glm::vec<3, T>(a * ((s.sigma_v / s.lv) * s.wv + s.tau * s.wu));
+}
 template <class T>
 inline bool membrane_forces(const DVec3Array& position, const Membrane& m, const MembraneTensor& c,
                             const SpringSettings& springs, glm::vec<3, T>& pu, glm::vec<3, T>& pv) {
     const MembraneStrain s = membrane_strain(position, m, c, springs);
     if (!s.valid) return false;
-    const double a = -double(m.area);
-    pu = glm::vec<3, T>(a * ((s.sigma_u / s.lu) * s.wu + s.tau * s.wv));
-    pv = glm::vec<3, T>(a * ((s.sigma_v / s.lv) * s.wv + s.tau * s.wu));
+    membrane_forces(s, double(m.area), pu, pv);
     return true;
 }
 
-// A membrane's energy A (C11 U_u(e_u) + C22 U_v(e_v) + C12 e_u e_v + 0.5 C66 gamma^2) (J).
+// A membrane's energy A (C11 U_u(e_u) + C22 U_v(e_v) + C12 e_u e_v + 0.5 C66 gamma^2) (J), each U a spring's
+// (spring_energy, on a rest length of 1); 0 for a collapsed one.
+inline double membrane_energy(const MembraneStrain& s, double area, const MembraneTensor& c, const SpringSettings& springs) {
+    if (!s.valid) return 0.0;
+    return area * (spring_energy(c.c11, springs.membrane_curve[0], s.eu, 1.0) +
+                   spring_energy(c.c22, springs.membrane_curve[1], s.ev, 1.0) + c.c12 * s.eu * s.ev +
+                   0.5 * c.c66 * s.gamma * s.gamma);
+}
 inline double membrane_energy(const DVec3Array& position, const Membrane& m, const MembraneTensor& c,
                               const SpringSettings& springs) {
-    const MembraneStrain s = membrane_strain(position, m, c, springs);
-    if (!s.valid) return 0.0;
-    auto stretch = [](double k, const SpringCurve& curve, double e) {
-        return curve.knots == 0 ? 0.5 * k * e * e : k * curve.energy_term(e, 1.0);
-    };
-    return double(m.area) * (stretch(c.c11, springs.membrane_curve[0], s.eu) + stretch(c.c22, springs.membrane_curve[1], s.ev) +
-                             c.c12 * s.eu * s.ev + 0.5 * c.c66 * s.gamma * s.gamma);
+    return membrane_energy(membrane_strain(position, m, c, springs), double(m.area), c, springs);
 }
 
 }  // namespace clothsim

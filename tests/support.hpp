@@ -10,11 +10,17 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <random>
+#include <utility>
+#include <numbers>
+#include <map>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace clothsim::test {
 
@@ -269,6 +275,145 @@ inline MassSpring pulled_sheet(int per_side, bool along_u, const MaterialSetting
     sim.set_substeps(auto_substeps(stability_limit(sim), settings.integration.dt, safety, 1));
     sim.run_steps(static_cast<long long>(std::ceil(20.0 / w / settings.integration.dt)));
     return sim;
+}
+
+// A rows x cols grid of spacing h in the x-z plane, each inner point jittered by up to `jitter` h (seeded), each
+// cell split along a diagonal chosen at random: an irregular triangulation, every triangle facing +y.
+struct Sheet {
+    std::vector<glm::dvec3> rest;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<bool> inner;
+};
+inline Sheet irregular_sheet(int rows, int cols, double h, double jitter, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-jitter * h, jitter * h);
+    Sheet s;
+    for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) {
+            const bool inside = r > 0 && c > 0 && r < rows - 1 && c < cols - 1;
+            s.rest.push_back({c * h + (inside ? u(rng) : 0.0), 0.0, r * h + (inside ? u(rng) : 0.0)});
+            s.inner.push_back(inside);
+        }
+    }
+    std::bernoulli_distribution flip(0.5);
+    auto at = [&](int r, int c) { return static_cast<std::uint32_t>(r * cols + c); };
+    for (int r = 0; r + 1 < rows; ++r) {
+        for (int c = 0; c + 1 < cols; ++c) {
+            // Counter-clockwise seen from +y (x cross z = -y, so the order is a, c, b).
+            if (flip(rng)) {
+                s.triangles.push_back({at(r, c), at(r + 1, c), at(r, c + 1)});
+                s.triangles.push_back({at(r, c + 1), at(r + 1, c), at(r + 1, c + 1)});
+            } else {
+                s.triangles.push_back({at(r, c), at(r + 1, c + 1), at(r, c + 1)});
+                s.triangles.push_back({at(r, c), at(r + 1, c), at(r + 1, c + 1)});
+            }
+        }
+    }
+    return s;
+}
+
+inline DVec3Array positions(const std::vector<glm::dvec3>& p) {
+    DVec3Array out;
+    out.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) out.set(i, p[i]);
+    return out;
+}
+
+// A triangle mesh: its vertices and its triangles.
+struct Mesh {
+    std::vector<glm::dvec3> vertices;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+// Signed area of triangle t projected on the x-z plane (the sign is its winding seen from -y).
+inline double signed_area(const Mesh& m, const std::array<std::uint32_t, 3>& t) {
+    const glm::dvec3 a = m.vertices[t[1]] - m.vertices[t[0]], b = m.vertices[t[2]] - m.vertices[t[0]];
+    return 0.5 * (a.z * b.x - a.x * b.z);
+}
+
+// Lawson's flips (Lawson 1977): an interior edge whose two opposite angles sum to more than pi is replaced by
+// the other diagonal of its quadrilateral, until none is left; the result is the Delaunay triangulation of the
+// points (flat, in the x-z plane). Windings are kept.
+inline void make_delaunay(Mesh& m) {
+    auto angle = [&](std::uint32_t p, std::uint32_t q, std::uint32_t at) {
+        const glm::dvec3 a = m.vertices[p] - m.vertices[at], b = m.vertices[q] - m.vertices[at];
+        return std::acos(std::clamp(glm::dot(a, b) / (glm::length(a) * glm::length(b)), -1.0, 1.0));
+    };
+    for (bool flipped = true; flipped;) {
+        flipped = false;
+        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> owner;  // directed edge -> triangle
+        for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
+            for (int k = 0; k < 3; ++k) owner[{m.triangles[t][k], m.triangles[t][(k + 1) % 3]}] = t;
+        }
+        std::vector<std::uint8_t> touched(m.triangles.size(), 0);
+        for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
+            for (int k = 0; k < 3 && !touched[t]; ++k) {
+                const std::uint32_t a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3], c = m.triangles[t][(k + 2) % 3];
+                const auto other = owner.find({b, a});
+                if (other == owner.end() || touched[other->second]) continue;
+                const std::uint32_t u = other->second;
+                std::uint32_t d = 0;
+                for (std::uint32_t i : m.triangles[u]) {
+                    if (i != a && i != b) d = i;
+                }
+                if (angle(a, b, c) + angle(a, b, d) <= std::numbers::pi + 1e-12) continue;
+                const double sign = signed_area(m, m.triangles[t]);
+                std::array<std::uint32_t, 3> first{c, a, d}, second{c, d, b};
+                if (signed_area(m, first) * sign < 0) std::swap(first[1], first[2]);
+                if (signed_area(m, second) * sign < 0) std::swap(second[1], second[2]);
+                m.triangles[t] = first;
+                m.triangles[u] = second;
+                touched[t] = touched[u] = 1;
+                flipped = true;
+            }
+        }
+    }
+}
+
+// An irregular Delaunay triangulation of a `length` x `width` rectangle in the x-z plane with edges about h
+// long: a triangular lattice (rows sqrt(3)/2 h apart, odd rows shifted by half a spacing, with a point on each
+// end), every point not on the boundary moved by up to jitter x h in x and z (seeded), rows zipped into
+// triangles, then Lawson's flips. Statistically isotropic, unlike a grid's cells.
+inline Mesh delaunay_rectangle(double h, double length, double width, double jitter, unsigned seed) {
+    const int rows = std::max(2, static_cast<int>(std::lround(width / (h * std::sqrt(3.0) / 2.0))) + 1);
+    const int cols = std::max(2, static_cast<int>(std::lround(length / h)) + 1);
+    const double dx = length / (cols - 1), dz = width / (rows - 1);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> offset(-jitter * h, jitter * h);
+    Mesh m;
+    std::vector<std::vector<std::uint32_t>> row(rows);
+    for (int r = 0; r < rows; ++r) {
+        std::vector<double> xs;
+        if (r % 2 == 0) {
+            for (int c = 0; c < cols; ++c) xs.push_back(c * dx);
+        } else {
+            xs.push_back(0.0);
+            for (int c = 0; c + 1 < cols; ++c) xs.push_back((c + 0.5) * dx);
+            xs.push_back(length);
+        }
+        for (std::size_t c = 0; c < xs.size(); ++c) {
+            glm::dvec3 p(xs[c], 0.0, r * dz);
+            const bool boundary = r == 0 || r + 1 == rows || c == 0 || c + 1 == xs.size();
+            if (!boundary) p += glm::dvec3(offset(rng), 0.0, offset(rng));
+            row[r].push_back(static_cast<std::uint32_t>(m.vertices.size()));
+            m.vertices.push_back(p);
+        }
+    }
+    for (int r = 0; r + 1 < rows; ++r) {
+        const auto &a = row[r], &b = row[r + 1];
+        std::size_t i = 0, j = 0;
+        while (i + 1 < a.size() || j + 1 < b.size()) {
+            if (j + 1 == b.size() || (i + 1 < a.size() && m.vertices[a[i + 1]].x < m.vertices[b[j + 1]].x)) {
+                m.triangles.push_back({a[i], a[i + 1], b[j]});
+                ++i;
+            } else {
+                m.triangles.push_back({a[i], b[j + 1], b[j]});
+                ++j;
+            }
+        }
+    }
+    make_delaunay(m);
+    return m;
 }
 
 }  // namespace clothsim::test

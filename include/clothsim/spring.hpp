@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 namespace clothsim {
 
@@ -84,6 +85,21 @@ struct Hinge {
 // (membrane.hpp: the grid's own continuum tensor, so a uniform strain stores what the grid's cells store). A
 // uniform strain of any triangulation is in equilibrium (the constant-strain patch test), which the edge springs
 // of an irregular mesh are not. bu and bv sum to 0 over the corners; bu_0 = -(bu_1 + bu_2) in double, rounded.
+// The Gaussian-curvature term of a flat mesh cloth's bending (model/gaussian_curvature.hpp). A plate's bending
+// energy is 0.5 (B_11 k_11^2 + 2 B_12 k_11 k_22 + B_22 k_22^2 + 4 B_66 k_12^2) in its curvatures k; the hinges'
+// sum stores some B_12 > 0 that depends on the triangulation (a bending Poisson ratio of about 1/3 on
+// equilateral triangles), while a woven fabric, as the grid's row and column bends, has B_12 = 0. Since
+// k_11 k_22 - k_12^2 is the Gaussian curvature K, the energy -B_12 integral(K dA) takes the coupling out, and
+// by the discrete Gauss-Bonnet theorem it is a sum over the rim alone: with phi the triangles' corner angles,
+//   E = c (pi T - 2 pi N_interior - sum over rim corners of phi),
+// T the triangles, N_interior the vertices off the rim, c = B_12 = bending.x weight_u + bending.y weight_v.
+// E is 0 at every flat shape. Built only for a rest shape whose hinges are all flat.
+struct GaussianCurvature {
+    std::vector<std::array<std::uint32_t, 3>> rim_corners;  // (a rim vertex, the triangle's next, its previous)
+    float weight_u = 0.0f, weight_v = 0.0f;  // B_12 per unit bending.x, per unit bending.y
+    double offset = 0.0;                      // pi T - 2 pi N_interior
+};
+
 struct Membrane {
     std::array<std::uint32_t, 3> v{};
     std::array<float, 3> bu{}, bv{};  // 1/m

@@ -81,6 +81,7 @@ struct Topology {
     // A mesh cloth's constant-strain triangles (cloth.membrane = "triangles"): its stretch and shear, where its
     // edge springs then have weight 0 (they still measure strain and tear).
     std::vector<Membrane> membranes;
+    GaussianCurvature gaussian;  // a flat mesh cloth's: its hinges' Poisson coupling taken out (spring.hpp)
     std::vector<SoftClipSpring> clip_springs;  // soft clips' particles (pins with clip = "soft")
     std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from u_axis x v_axis
     // The triangles are every grid cell's two, in row-major cell order: (00, 01, 10) and (01, 11, 10) for the

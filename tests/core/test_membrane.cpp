@@ -5,6 +5,7 @@
 
 #include "model/forces.hpp"
 #include "model/membrane.hpp"
+#include "support.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -17,49 +18,9 @@ using namespace clothsim;
 
 namespace {
 
-using Triangles = std::vector<std::array<std::uint32_t, 3>>;
-
-// A rows x cols grid of spacing h in the x-z plane, each inner point jittered by up to `jitter` h (seeded), each
-// cell split along a diagonal chosen at random: an irregular triangulation, every triangle facing +y.
-struct Sheet {
-    std::vector<glm::dvec3> rest;
-    Triangles triangles;
-    std::vector<bool> inner;
-};
-Sheet irregular_sheet(int rows, int cols, double h, double jitter, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(-jitter * h, jitter * h);
-    Sheet s;
-    for (int r = 0; r < rows; ++r) {
-        for (int c = 0; c < cols; ++c) {
-            const bool inside = r > 0 && c > 0 && r < rows - 1 && c < cols - 1;
-            s.rest.push_back({c * h + (inside ? u(rng) : 0.0), 0.0, r * h + (inside ? u(rng) : 0.0)});
-            s.inner.push_back(inside);
-        }
-    }
-    std::bernoulli_distribution flip(0.5);
-    auto at = [&](int r, int c) { return static_cast<std::uint32_t>(r * cols + c); };
-    for (int r = 0; r + 1 < rows; ++r) {
-        for (int c = 0; c + 1 < cols; ++c) {
-            // Counter-clockwise seen from +y (x cross z = -y, so the order is a, c, b).
-            if (flip(rng)) {
-                s.triangles.push_back({at(r, c), at(r + 1, c), at(r, c + 1)});
-                s.triangles.push_back({at(r, c + 1), at(r + 1, c), at(r + 1, c + 1)});
-            } else {
-                s.triangles.push_back({at(r, c), at(r + 1, c + 1), at(r, c + 1)});
-                s.triangles.push_back({at(r, c), at(r + 1, c), at(r + 1, c + 1)});
-            }
-        }
-    }
-    return s;
-}
-
-DVec3Array positions(const std::vector<glm::dvec3>& p) {
-    DVec3Array out;
-    out.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) out.set(i, p[i]);
-    return out;
-}
+using test::irregular_sheet;
+using test::positions;
+using test::Sheet;
 
 SpringSettings material_springs(glm::vec2 stretch, float shear) {
     SpringSettings s;
@@ -84,7 +45,7 @@ TEST_CASE("membrane: the tensor's uniaxial stiffness is material.stretch along u
 
 TEST_CASE("membrane: its forces are its energy's negative gradient, linear and with stretch curves", "[membrane]") {
     const std::vector<glm::dvec3> rest = {{0.0, 0.0, 0.0}, {0.013, 0.001, 0.002}, {0.004, -0.002, 0.011}};
-    const Triangles tri = {{0, 1, 2}};
+    const std::vector<std::array<std::uint32_t, 3>> tri = {{0, 1, 2}};
     const Membrane m = membrane_triangles(rest, tri, {1.0, 0.0, 0.0})[0];
     SpringSettings springs = material_springs({3000.0f, 1200.0f}, 80.0f);
     const bool curved = GENERATE(false, true);

@@ -1,6 +1,7 @@
 #include "clothsim/stability.hpp"
 
 #include "model/forces.hpp"
+#include "model/gaussian_curvature.hpp"
 #include "model/membrane.hpp"
 #include "collision/penalty_contact.hpp"
 
@@ -140,6 +141,18 @@ StabilityLimit stability_limit(const Topology& topology, const State& state, con
                 row_sum[m.v[i]] += double(m.area) * (tensor.c11 * tu * bu * su + tensor.c22 * tv * bv * sv +
                                                      tensor.c12 * (bu * sv + bv * su) + tensor.c66 * (bu + bv) * (su + sv));
             }
+        }
+    }
+    // The Gaussian-curvature term (gaussian_curvature.hpp): c times a rim corner's angle, whose Hessian's blocks are
+    // of size 1 / (|e_i| |e_j|) for a triangle of good shape: 4 |c| (1/|e_1| + 1/|e_2|)^2 on each of its corners.
+    if (has_gaussian_term(topology, settings.springs)) {
+        const double coefficient = std::abs(gaussian_coefficient(topology.gaussian, settings.springs));
+        for (const auto& corner : topology.gaussian.rim_corners) {
+            const glm::dvec3 xa = state.position.get(corner[0]);
+            const double l1 = glm::length(state.position.get(corner[1]) - xa), l2 = glm::length(state.position.get(corner[2]) - xa);
+            if (!(l1 > 0.0) || !(l2 > 0.0)) continue;
+            const double r = 4.0 * coefficient * (1.0 / l1 + 1.0 / l2) * (1.0 / l1 + 1.0 / l2);
+            for (std::uint32_t i : corner) row_sum[i] += r;
         }
     }
     for (const SoftClipSpring& h : topology.clip_springs) row_sum[h.particle] += h.stiffness;

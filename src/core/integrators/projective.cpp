@@ -2,6 +2,7 @@
 #include "integrators/integrator_step.hpp"
 
 #include "model/forces.hpp"
+#include "model/gaussian_curvature.hpp"
 #include "model/membrane.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -325,6 +326,14 @@ LinearSolve ProjectiveSolver::step(State& state, const Topology& topology, const
                     rhs.row(r) += Eigen::RowVector3d(b.x, b.y, b.z);
                 }
             }
+        }
+        // The Gaussian-curvature term's (gaussian_curvature.hpp): none of it in A, all its force in b(x).
+        if (has_gaussian_term(topology, springs)) {
+            e += gaussian_energy(topology, position, springs);
+            visit_gaussian_forces(topology, position, springs, [&](std::uint32_t i, const glm::dvec3& force) {
+                const int r = f.free_index[i];
+                if (r >= 0) rhs.row(r) += Eigen::RowVector3d(force.x, force.y, force.z);
+            });
         }
         for (const SoftClipSpring& hold : topology.clip_springs) {
             const glm::dvec3 d = position.get(hold.particle) - hold.anchor;

@@ -3,6 +3,7 @@
 
 #include "integrators/xpbd_projection.hpp"
 #include "model/forces.hpp"
+#include "model/gaussian_curvature.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -19,6 +20,7 @@ void step_xpbd(State& state, const Dynamics& dynamics, const Topology& topology,
     DVec3Array a;
     wind.resize(n);
     dynamics.external(state, wind);
+    accumulate_gaussian_forces(topology, state.position, springs, wind);  // a force, not a constraint
     accelerations(state, wind, dynamics.gravity, dynamics.damping, a);
     const DVec3Array start = state.position;
     for (std::size_t i = 0; i < n; ++i) {

@@ -3,6 +3,7 @@
 #include "integrators/fast_solver.hpp"
 #include "integrators/work_team.hpp"
 #include "model/forces.hpp"
+#include "model/gaussian_curvature.hpp"
 #include "model/membrane.hpp"
 
 #include <glm/geometric.hpp>
@@ -358,6 +359,7 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
             force.set(i, sum);
         }
     });
+    accumulate_gaussian_forces(topology, position, springs, force);  // the rim alone: one thread
 }
 
 }  // namespace clothsim

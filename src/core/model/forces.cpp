@@ -1,5 +1,6 @@
 #include "model/forces.hpp"
 
+#include "model/gaussian_curvature.hpp"
 #include "model/membrane.hpp"
 
 #include <glm/geometric.hpp>
@@ -45,16 +46,18 @@ void accumulate_spring_forces(const Topology& topology, const DVec3Array& positi
         const Vec e = kh * Vec(hinge_difference(position, h));
         for (int i = 0; i < 4; ++i) force.add(h.v[i], -T(h.c[i]) * e);
     }
-    if (topology.membranes.empty()) return;
-    const MembraneTensor c = membrane_tensor(springs);
-    for (const Membrane& m : topology.membranes) {
-        Vec pu, pv;
-        if (!membrane_forces(position, m, c, springs, pu, pv)) continue;
-        for (int i = 0; i < 3; ++i) {
-            force.add(m.v[i], T(m.bu[i]) * pu);
-            force.add(m.v[i], T(m.bv[i]) * pv);
+    if (!topology.membranes.empty()) {
+        const MembraneTensor c = membrane_tensor(springs);
+        for (const Membrane& m : topology.membranes) {
+            Vec pu, pv;
+            if (!membrane_forces(position, m, c, springs, pu, pv)) continue;
+            for (int i = 0; i < 3; ++i) {
+                force.add(m.v[i], T(m.bu[i]) * pu);
+                force.add(m.v[i], T(m.bv[i]) * pv);
+            }
         }
     }
+    accumulate_gaussian_forces(topology, position, springs, force);
 }
 
 glm::vec3 wind_velocity(const ForceSettings& forces, double time) {
@@ -134,6 +137,7 @@ double spring_potential_energy(const Topology& topology, const DVec3Array& posit
         const MembraneTensor c = membrane_tensor(springs);
         for (const Membrane& m : topology.membranes) energy += membrane_energy(position, m, c, springs);
     }
+    energy += gaussian_energy(topology, position, springs);
     for (const SoftClipSpring& h : topology.clip_springs) {
         const glm::dvec3 d = position.get(h.particle) - h.anchor;
         energy += 0.5 * double(h.stiffness) * glm::dot(d, d);

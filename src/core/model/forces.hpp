@@ -14,7 +14,7 @@ namespace clothsim {
 // stretch curve: k w t(|d| - L0) d/|d|, t its SpringCurve::stretch_term); then the bends
 // (spring.hpp): with d = x_a - 2 x_m + x_b, F_a = F_b = -k w d and F_m = 2 k w d; then the hinges: with
 // d = sum_i c_i x_i, F_i = -k c_i d; then a mesh cloth's membrane triangles (membrane.hpp): bu_i p_u, then
-// bv_i p_v, on each corner i. A spring with L0 = 0 uses
+// bv_i p_v, on each corner i; then a flat mesh cloth's Gaussian-curvature term (gaussian_curvature.hpp). A spring with L0 = 0 uses
 // F_a = k d (the same formula without the division); one with L0 > 0 whose ends coincide has no direction
 // and contributes nothing rather than NaN.
 // d is taken in double and rounded once to the force type F; the rest is computed in F. Instantiated for
@@ -42,7 +42,8 @@ void accumulate_wind_forces(const Topology& topology, const State& state, const 
                             double rest_area, BasicVec3Array<F>& force);
 
 // Elastic energy 0.5 k w (|d| - L0)^2 summed over springs, plus 0.5 k w |x_a - 2 x_m + x_b|^2 over bends,
-// 0.5 k |sum_i c_i x_i|^2 over hinges, the membrane triangles' energy (membrane.hpp) and
+// 0.5 k |sum_i c_i x_i|^2 over hinges, the membrane triangles' energy (membrane.hpp), the Gaussian-curvature
+// term's (gaussian_curvature.hpp) and
 // 0.5 k |x - anchor|^2 over soft clips' holds (J).
 double spring_potential_energy(const Topology& topology, const DVec3Array& position,
                                const SpringSettings& springs);

@@ -1,5 +1,7 @@
 #include "model/tearing.hpp"
 
+#include "model/gaussian_curvature.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -66,7 +68,12 @@ std::size_t break_springs(Topology& topology, const std::function<bool(const Spr
         return broken.count(pair_key(t[0], t[1])) != 0 || broken.count(pair_key(t[1], t[2])) != 0 ||
                broken.count(pair_key(t[2], t[0])) != 0;
     });
-    if (topology.triangles.size() != triangles) topology.cell_triangles = false;
+    if (topology.triangles.size() != triangles) {
+        topology.cell_triangles = false;
+        if (!topology.gaussian.rim_corners.empty()) {  // the cut's sides join the rim
+            find_rim(topology.gaussian, topology.triangles, static_cast<std::size_t>(topology.rows) * topology.cols);
+        }
+    }
     topology.count_by_kind();
     return removed;
 }

@@ -3,6 +3,7 @@
 
 #include "clothsim/scene.hpp"
 #include "clothsim/shapes/mesh.hpp"
+#include "model/gaussian_curvature.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -312,6 +313,7 @@ Topology mesh_topology(const std::vector<glm::dvec3>& rest, const Triangles& tri
         h.weight_v = float(w * cu);
         t.hinges.push_back(h);
     }
+    t.gaussian = gaussian_curvature(rest, triangles, t.hinges, u);
     // Texture coordinates: the rest shape on u and on n x u, n the mean normal (by area).
     glm::dvec3 normal(0.0);
     for (const auto& c : triangles) normal += glm::cross(rest[c[1]] - rest[c[0]], rest[c[2]] - rest[c[0]]);

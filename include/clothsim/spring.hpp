@@ -62,11 +62,11 @@ struct Bend {
 // a_t and b_t the angles of triangle t at v[0] and v[1]. The weights sum to 0 and sum_i c_i x_i vanishes for
 // the flat rest shape, so the energy is 0 there and for any rigid motion of it; for a dihedral angle theta,
 // |sum_i c_i x_i| = 2 |e| sin(theta / 2). k = B / (A_0 + A_1) gives a cylinder of curvature kappa the plate
-// energy 0.5 B kappa^2 per area (docs/MESH_CLOTH.md measures it; Bergou et al.'s 3 / (A_0 + A_1) with this
-// stencil stores three times that), B the flexural rigidity across the edge: with B_u and B_v bending along u
-// and along v, B = B_u w_u + B_v w_v, w_u = sin^2 and w_v = cos^2 of the rest edge's angle to u_axis (an edge
-// along u bends along v). So k = bending.x weight_u + bending.y weight_v, the weights (1/m^2) holding
-// 1 / (A_0 + A_1) times those shares.
+// energy of about 0.5 B kappa^2 per area (docs/MESH_CLOTH.md measures it; Bergou et al.'s 3 / (A_0 + A_1) with
+// this stencil stores three times that). k = bending.x weight_u + bending.y weight_v (held at 0 or more): in the
+// per-spring form the weights are sin^2 and cos^2 of the rest edge's angle to u_axis (an edge along u bends along
+// v); in the material form (1/m^2) they are calibrated so that the mesh bent along u stores bending.x and along v
+// bending.y (cloth_mesh.cpp, calibrate_hinges), and a share may be negative.
 struct Hinge {
     std::array<std::uint32_t, 4> v{};
     std::array<float, 4> c{};

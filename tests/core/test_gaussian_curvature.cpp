@@ -125,7 +125,7 @@ TEST_CASE("gaussian curvature: with it, the hinges' energy under a uniform curva
         const Topology with = sheet_topology(sheet);
         Topology without = with;
         without.gaussian = {};
-        const double area = area_of(sheet), a = 2.0;  // a 0.5 m radius over a 0.3 m sheet
+        const double area = area_of(sheet), a = 0.2;  // a 5 m radius over a 0.3 m sheet: slopes under 0.03
         for (const glm::vec2 bending : {glm::vec2(1e-3f), glm::vec2(1e-3f, 4e-3f)}) {
             const SpringSettings springs = bending_only(bending);
             auto coupling = [&](const Topology& t) {
@@ -137,11 +137,13 @@ TEST_CASE("gaussian curvature: with it, the hinges' energy under a uniform curva
             INFO((sheet.inner.empty() ? "Delaunay" : "grid cells") << ", bending " << bending.x << ", " << bending.y << ": B_11 "
                  << b11 << ", B_12 " << b12_hinges << " (hinges), " << b12 << " (with the term)");
             CHECK(std::abs(b12_hinges) > 0.05 * b11);
-            // What is left is the rim's: its triangles sit in fewer hinges, so the hinges couple less there than the
-            // interior's B_12, the term's weight, takes out (4% of this sheet's area is in rim triangles).
-            CHECK(std::abs(b12) < 0.12 * std::abs(b12_hinges));
-            // A cylinder's K is 0: the term stores next to nothing (z = 0.5 a x^2 is an isometry to second order).
-            CHECK(along(without) == Approx(b11).epsilon(3e-3));
+            CHECK(std::abs(b12) < 0.01 * std::abs(b12_hinges));
+            // The term's weight is the hinges' B_12 itself: the mesh as a whole stores the material's B_11 = bending.x
+            // (the hinges' calibration, cloth_mesh.hpp) and no coupling.
+            CHECK(b11 == Approx(bending.x).epsilon(0.01));
+            // A cylinder's K is 0: the term stores next to nothing (the angle defects of triangles inscribed in a
+            // cylinder are not quite 0 on an irregular mesh: under 0.5% of the bending energy here).
+            CHECK(along(without) == Approx(b11).epsilon(5e-3));
         }
     }
 }

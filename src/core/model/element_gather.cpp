@@ -174,8 +174,10 @@ CLOTHSIM_AVX512 void hinges_avx512(ElementGather& g, const DVec3Array& position,
         for (std::size_t k = 0; k < 4; ++k) v[k] = _mm256_maskz_loadu_epi32(live, &g.hinge_v[k][h]);
         __m512d c[3];
         for (std::size_t k = 0; k < 3; ++k) c[k] = _mm512_maskz_cvtps_pd(__mmask8(0xFF), _mm256_maskz_loadu_ps(live, &g.hinge_c[k][h]));
-        const __m256 kh = _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(springs.bending.x), _mm256_maskz_loadu_ps(live, &g.hinge_weight_u[h])),
-                                        _mm256_mul_ps(_mm256_set1_ps(springs.bending.y), _mm256_maskz_loadu_ps(live, &g.hinge_weight_v[h])));
+        const __m256 kh = _mm256_max_ps(
+            _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(springs.bending.x), _mm256_maskz_loadu_ps(live, &g.hinge_weight_u[h])),
+                          _mm256_mul_ps(_mm256_set1_ps(springs.bending.y), _mm256_maskz_loadu_ps(live, &g.hinge_weight_v[h]))),
+            _mm256_setzero_ps());  // stiffness_of's max(0, k)
         const __mmask8 set = live & _mm256_cmp_ps_mask(kh, _mm256_setzero_ps(), _CMP_NEQ_UQ);
         const __m512d zero = _mm512_setzero_pd();
         const std::size_t at = g.springs + h;

@@ -88,8 +88,9 @@ inline double spring_energy(double k, const SpringCurve& curve, double stretch, 
 inline float stiffness_of(const SpringSettings& springs, const Bend& b) {
     return stiffness_of(springs, SpringKind::Bending, b.axis) * b.weight;
 }
+// A hinge's k, kept at 0 or more: a calibrated hinge's share can be negative (cloth_mesh.cpp, calibrate_hinges).
 inline float stiffness_of(const SpringSettings& springs, const Hinge& h) {
-    return springs.bending.x * h.weight_u + springs.bending.y * h.weight_v;
+    return std::max(0.0f, springs.bending.x * h.weight_u + springs.bending.y * h.weight_v);
 }
 // A hinge's sum_i c_i x_i (spring.hpp), in double, for particles v and weights c.
 inline glm::dvec3 hinge_difference(const DVec3Array& position, const std::array<std::size_t, 4>& v,

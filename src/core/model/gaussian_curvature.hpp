@@ -13,14 +13,24 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace clothsim {
 
+// A hinge's response to a uniform curvature of its rest shape: for z = 0.5 (a u^2 + b v^2) in the plane of its first
+// triangle (u: u_axis projected on that plane, v across it), its sum_i c_i z_i is a alpha + b beta (m^2), exactly:
+// the hinge's energy is quadratic. `flat`: its two rest triangles lie in one plane (within 1e-6 rad); `area` the
+// two triangles' (m^2). Empty for a degenerate hinge (a triangle of no area, or one across u_axis).
+struct HingeResponse {
+    double alpha = 0.0, beta = 0.0, area = 0.0;
+    bool flat = true;
+};
+std::optional<HingeResponse> hinge_response(const std::vector<glm::dvec3>& rest, const Hinge& hinge, glm::dvec3 u_axis);
+
 // The term of a mesh with hinges `hinges` (built on `rest` with u_axis `u_axis`): its weights, B_12 per unit
-// bending.x and bending.y of the hinges' energy for a uniform curvature of the rest shape (each hinge's
-// sum_i c_i z_i for z = 0.5 (a u^2 + b v^2) in its own plane is a alpha + b beta, so B_12 is sum k alpha beta over
-// the hinges' area), and its rim (find_rim). No term (weights 0) when a hinge's rest shape is not flat: the
+// bending.x and bending.y of the hinges' energy for a uniform curvature of the rest shape (hinge_response: B_12 is
+// sum k alpha beta over the mesh's area), and its rim (find_rim). No term (weights 0) when a hinge's rest shape is not flat: the
 // energy -B_12 integral(K dA) is stationary only at a flat shape.
 GaussianCurvature gaussian_curvature(const std::vector<glm::dvec3>& rest,
                                      const std::vector<std::array<std::uint32_t, 3>>& triangles,

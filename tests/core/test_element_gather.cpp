@@ -1,5 +1,6 @@
 // The gather of a mesh cloth's spring and hinge forces on the team (element_gather.hpp) against the list path.
 #include "model/element_gather.hpp"
+#include "model/gaussian_curvature.hpp"
 
 #include "clothsim/cloth_mesh.hpp"
 #include "clothsim/scene.hpp"
@@ -13,7 +14,7 @@
 
 using namespace clothsim;
 
-TEST_CASE("element gather: a mesh cloth's spring, hinge and membrane forces on the team equal the list path's bit for "
+TEST_CASE("element gather: a mesh cloth's spring, hinge, membrane and rim-corner forces on the team equal the list path's bit for "
           "bit, with every kernel the CPU runs, on 1, 2 and 3 threads, linear and with stretch curves", "[element_gather]") {
     // The conforming Cusick disc (1951 vertices), every particle moved at random by up to a tenth of an edge,
     // with an anisotropic fabric; one spring given stiffness 0 and one length 0, as the list path skips them.
@@ -32,6 +33,7 @@ TEST_CASE("element gather: a mesh cloth's spring, hinge and membrane forces on t
     Topology topology = sim.topology();
     REQUIRE(topology.mesh);
     REQUIRE(!topology.hinges.empty());
+    REQUIRE(has_gaussian_term(topology, sim.settings().springs));  // the flat disc's rim corners (gaussian_curvature.hpp)
     REQUIRE(topology.membranes.size() == (triangles ? topology.triangles.size() : 0));
     if (triangles) {
         for (const Spring& s : topology.springs) REQUIRE(s.weight == 0.0f);  // the edges carry nothing: the gather leaves them out

@@ -410,7 +410,7 @@ void ColouredXpbd::step(State& state, const Dynamics& dynamics, const Topology& 
     // Predict with the external accelerations, as step_xpbd.
     wind_.resize(n);
     dynamics.external(state, wind_);
-    accumulate_gaussian_forces(topology, state.position, springs, wind_);  // a force, not a constraint
+    accumulate_gaussian_forces_fast(topology, state.position, springs, wind_);  // a force, not a constraint
     accelerations(state, wind_, dynamics.gravity, dynamics.damping, a_);
     start_ = state.position;
     for (std::size_t i = 0; i < n; ++i) {

@@ -31,9 +31,10 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
     g.springs = topology.membranes.empty() ? topology.springs.size() : 0;
     g.hinges = topology.hinges.size();
     g.membranes = topology.membranes.size();
+    g.corners = topology.gaussian.rim_corners.size();
     const std::size_t n = static_cast<std::size_t>(topology.rows) * static_cast<std::size_t>(topology.cols);
     g.begin.assign(n + 1, 0);
-    auto each = [&](auto&& visit) {  // in list order: springs, then hinges, then membranes
+    auto each = [&](auto&& visit) {  // in list order: springs, then hinges, then membranes, then rim corners
         for (std::size_t j = 0; j < g.springs; ++j) {
             visit(topology.springs[j].a, j, 1.0f);
             visit(topology.springs[j].b, j, -1.0f);
@@ -49,6 +50,10 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
                 visit(t.v[i], slot + 1, t.bv[i]);
             }
         }
+        for (std::size_t c = 0; c < g.corners; ++c) {
+            const std::size_t slot = g.springs + g.hinges + 2 * g.membranes + 3 * c;
+            for (std::size_t k = 0; k < 3; ++k) visit(topology.gaussian.rim_corners[c][k], slot + k, 1.0f);
+        }
     };
     each([&](std::uint32_t particle, std::size_t, float) { ++g.begin[particle + 1]; });
     for (std::size_t i = 0; i < n; ++i) g.begin[i + 1] += g.begin[i];
@@ -59,7 +64,7 @@ ElementGather ElementGather::for_topology(const Topology& topology) {
         g.source[fill[particle]] = static_cast<std::uint32_t>(element);
         g.coefficient[fill[particle]++] = c;
     });
-    g.element_force.resize(g.springs + g.hinges + 2 * g.membranes);
+    g.element_force.resize(g.springs + g.hinges + 2 * g.membranes + 3 * g.corners);
     for (std::size_t j = 0; j < g.springs; ++j) {
         const Spring& sp = topology.springs[j];
         g.spring_a.push_back(static_cast<std::int32_t>(sp.a));
@@ -289,13 +294,25 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
     using Vec = glm::vec3;
     WorkTeam& team = WorkTeam::shared();
     const int spring_pieces = WorkTeam::pieces(g.springs, kPiece), hinge_pieces = WorkTeam::pieces(g.hinges, kPiece);
-    const int membrane_pieces = WorkTeam::pieces(g.membranes, kPiece);
+    const int membrane_pieces = WorkTeam::pieces(g.membranes, kPiece), corner_pieces = WorkTeam::pieces(g.corners, kPiece);
     const MembraneTensor tensor = membrane_tensor(springs);
+    const double gaussian = gaussian_coefficient(topology.gaussian, springs);
     // Each element's force, as accumulate_spring_forces computes it (an element it skips gets zero, which adds
     // nothing: a sum that starts at +0 never becomes -0).
     const bool wide = FastSolver::kernel() == FastKernel::Avx512;
     const bool curved = has_mesh_curves(springs);  // springs with curves in the scalar loop (its hinge sums)
-    team.run(threads, spring_pieces + hinge_pieces + membrane_pieces, [&](int piece, int) {
+    team.run(threads, spring_pieces + hinge_pieces + membrane_pieces + corner_pieces, [&](int piece, int) {
+        if (piece >= spring_pieces + hinge_pieces + membrane_pieces) {  // rim corners (gaussian_curvature.hpp)
+            const std::size_t first = static_cast<std::size_t>(piece - spring_pieces - hinge_pieces - membrane_pieces) * kPiece;
+            const std::size_t last = std::min(g.corners, first + kPiece);
+            const std::size_t slot = g.springs + g.hinges + 2 * g.membranes + 3 * first;
+            if (gaussian == 0.0) {
+                for (std::size_t k = slot; k < slot + 3 * (last - first); ++k) g.element_force.set(k, Vec(0.0f));
+                return;
+            }
+            gaussian_corner_forces(topology.gaussian, position, gaussian, first, last, g.element_force, slot);
+            return;
+        }
         if (piece < spring_pieces) {
             const std::size_t first = static_cast<std::size_t>(piece) * kPiece, last = std::min(g.springs, first + kPiece);
             if (wide && !curved) {
@@ -361,7 +378,6 @@ void gather_spring_forces(const Topology& topology, ElementGather& g, const DVec
             force.set(i, sum);
         }
     });
-    accumulate_gaussian_forces(topology, position, springs, force);  // the rim alone: one thread
 }
 
 }  // namespace clothsim

@@ -26,7 +26,8 @@ struct ElementGather {
     // its negation), a hinge's is -c_slot, a membrane's bu_i on p_u and bv_i on p_v.
     std::vector<std::uint32_t> begin, source;
     std::vector<float> coefficient;
-    std::size_t springs = 0, hinges = 0, membranes = 0;
+    // Then each rim corner's forces on its a, p and q (gaussian_curvature.hpp; coefficient 1).
+    std::size_t springs = 0, hinges = 0, membranes = 0, corners = 0;
     Vec3Array element_force;
     // The elements as the AVX-512 element pass reads them, in list order: a spring's ends, rest length, weight
     // and which stiffness of the settings it takes (0 structural u, 1 structural v, 2 shear, 3 bending u, 4

@@ -1,6 +1,10 @@
 #include "model/gaussian_curvature.hpp"
 
+#include "integrators/fast_solver.hpp"
+
 #include <glm/geometric.hpp>
+
+#include <immintrin.h>
 
 #include <algorithm>
 #include <cmath>
@@ -120,6 +124,99 @@ void accumulate_gaussian_forces(const Topology& topology, const DVec3Array& posi
                                 BasicVec3Array<F>& force) {
     using Vec = glm::vec<3, F>;
     visit_gaussian_forces(topology, position, springs, [&](std::uint32_t i, const glm::dvec3& f) { force.add(i, Vec(f)); });
+}
+
+namespace {
+
+#define CLOTHSIM_AVX512 __attribute__((target("avx512f,avx512vl,avx2,fma")))
+
+// (x x + y y) + z z of eight vectors, glm::dot's order.
+CLOTHSIM_AVX512 inline __m512d dot8(const __m512d* x, const __m512d* y) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(x[0], y[0]), _mm512_mul_pd(x[1], y[1])), _mm512_mul_pd(x[2], y[2]));
+}
+
+// Corners [first, first + 8) (fewer at the end): each one's forces on a, p and q, rounded to float, into out[vertex
+// 0..2][axis][lane]; live lanes with a normal in `valid`.
+CLOTHSIM_AVX512 __mmask8 corners_avx512(const GaussianCurvature& term, const DVec3Array& position, double c,
+                                        std::size_t first, float (&out)[3][3][8]) {
+    const std::size_t count = std::min<std::size_t>(8, term.rim_corners.size() - first);
+    const __mmask8 live = count == 8 ? __mmask8(0xFF) : __mmask8((1u << count) - 1u);
+    const int* base = reinterpret_cast<const int*>(term.rim_corners.data() + first);
+    const __m256i stride = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    const double* p[3] = {position.x.data(), position.y.data(), position.z.data()};
+    __m512d x[3][3];  // [vertex a, p, q][axis]
+    for (int k = 0; k < 3; ++k) {
+        const __m256i index = _mm256_mmask_i32gather_epi32(_mm256_setzero_si256(), live, stride, base + k, 4);
+        for (int axis = 0; axis < 3; ++axis) x[k][axis] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), live, index, p[axis], 8);
+    }
+    __m512d e1[3], e2[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        e1[axis] = _mm512_sub_pd(x[1][axis], x[0][axis]);
+        e2[axis] = _mm512_sub_pd(x[2][axis], x[0][axis]);
+    }
+    const __m512d e11 = dot8(e1, e1), e22 = dot8(e2, e2), e12 = dot8(e1, e2);
+    const __m512d area2 = _mm512_sub_pd(_mm512_mul_pd(e11, e22), _mm512_mul_pd(e12, e12));
+    const __mmask8 valid = live & _mm512_cmp_pd_mask(area2, _mm512_setzero_pd(), _CMP_GT_OQ);
+    const __m512d one = _mm512_set1_pd(1.0);
+    const __m512d r = _mm512_div_pd(_mm512_set1_pd(c),
+                                    _mm512_mul_pd(_mm512_mul_pd(_mm512_mask_sqrt_pd(one, valid, area2), e11), e22));
+    const __m512d rp = _mm512_mul_pd(r, e22), rq = _mm512_mul_pd(r, e11);
+    for (int axis = 0; axis < 3; ++axis) {
+        const __m512d fp = _mm512_mul_pd(rp, _mm512_sub_pd(_mm512_mul_pd(e1[axis], e12), _mm512_mul_pd(e2[axis], e11)));
+        const __m512d fq = _mm512_mul_pd(rq, _mm512_sub_pd(_mm512_mul_pd(e2[axis], e12), _mm512_mul_pd(e1[axis], e22)));
+        const __m512d fa = _mm512_mul_pd(_mm512_add_pd(fp, fq), _mm512_set1_pd(-1.0));  // -(fp + fq), signed zeros too
+        _mm256_storeu_ps(out[0][axis], _mm512_maskz_cvtpd_ps(__mmask8(0xFF), fa));
+        _mm256_storeu_ps(out[1][axis], _mm512_maskz_cvtpd_ps(__mmask8(0xFF), fp));
+        _mm256_storeu_ps(out[2][axis], _mm512_maskz_cvtpd_ps(__mmask8(0xFF), fq));
+    }
+    return valid;
+}
+
+}  // namespace
+
+void gaussian_corner_forces(const GaussianCurvature& term, const DVec3Array& position, double c, std::size_t first,
+                            std::size_t last, Vec3Array& out, std::size_t slot) {
+    if (FastSolver::kernel() == FastKernel::Avx512) {
+        float f[3][3][8];
+        for (std::size_t at = first; at < last; at += 8) {
+            const __mmask8 valid = corners_avx512(term, position, c, at, f);
+            for (std::size_t lane = 0; lane < 8 && at + lane < last; ++lane) {
+                const bool set = valid >> lane & 1u;
+                for (int k = 0; k < 3; ++k) {
+                    out.set(slot + 3 * (at + lane - first) + k,
+                            set ? glm::vec3(f[k][0][lane], f[k][1][lane], f[k][2][lane]) : glm::vec3(0.0f));
+                }
+            }
+        }
+        return;
+    }
+    for (std::size_t at = first; at < last; ++at) {
+        const auto& [a, p, q] = term.rim_corners[at];
+        glm::dvec3 f[3];
+        const bool set = corner_forces(position.get(a), position.get(p), position.get(q), c, f[0], f[1], f[2]);
+        for (int k = 0; k < 3; ++k) out.set(slot + 3 * (at - first) + k, set ? glm::vec3(f[k]) : glm::vec3(0.0f));
+    }
+}
+
+void accumulate_gaussian_forces_fast(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
+                                     Vec3Array& force) {
+    const double c = gaussian_coefficient(topology.gaussian, springs);
+    if (c == 0.0) return;
+    if (FastSolver::kernel() != FastKernel::Avx512) {
+        accumulate_gaussian_forces(topology, position, springs, force);
+        return;
+    }
+    const auto& corners = topology.gaussian.rim_corners;
+    float out[3][3][8];
+    for (std::size_t first = 0; first < corners.size(); first += 8) {
+        const __mmask8 valid = corners_avx512(topology.gaussian, position, c, first, out);
+        for (std::size_t lane = 0; lane < 8 && first + lane < corners.size(); ++lane) {
+            if (!(valid >> lane & 1u)) continue;
+            for (int k = 0; k < 3; ++k) {
+                force.add(corners[first + lane][k], glm::vec3(out[k][0][lane], out[k][1][lane], out[k][2][lane]));
+            }
+        }
+    }
 }
 
 double gaussian_energy(const Topology& topology, const DVec3Array& position, const SpringSettings& springs) {

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -47,6 +48,23 @@ inline bool has_gaussian_term(const Topology& topology, const SpringSettings& sp
     return !topology.gaussian.rim_corners.empty() && gaussian_coefficient(topology.gaussian, springs) != 0.0;
 }
 
+// One rim corner's forces c grad(phi) on its vertices a, p, q at xa, xp, xq; false (and nothing written) for a
+// corner with no normal (a collapsed triangle).
+inline bool corner_forces(const glm::dvec3& xa, const glm::dvec3& xp, const glm::dvec3& xq, double c, glm::dvec3& fa,
+                          glm::dvec3& fp, glm::dvec3& fq) {
+    const glm::dvec3 e1 = xp - xa, e2 = xq - xa;
+    // |e_1 x e_2|^2 by Lagrange's identity; e_1 x n = (e_1 (e_1.e_2) - e_2 |e_1|^2) / |e_1 x e_2| and
+    // n x e_2 = (e_2 (e_1.e_2) - e_1 |e_2|^2) / |e_1 x e_2|: one square root and one division a corner.
+    const double e11 = glm::dot(e1, e1), e22 = glm::dot(e2, e2), e12 = glm::dot(e1, e2);
+    const double area2 = e11 * e22 - e12 * e12;
+    if (!(area2 > 0.0)) return false;
+    const double r = c / (std::sqrt(area2) * e11 * e22);
+    fp = (r * e22) * (e1 * e12 - e2 * e11);
+    fq = (r * e11) * (e2 * e12 - e1 * e22);
+    fa = -(fp + fq);
+    return true;
+}
+
 // Calls visit(i, f) for each force f (N, double) of the term on particle i, as accumulate_gaussian_forces adds them.
 template <class Visit>
 void visit_gaussian_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
@@ -54,15 +72,9 @@ void visit_gaussian_forces(const Topology& topology, const DVec3Array& position,
     const double c = gaussian_coefficient(topology.gaussian, springs);
     if (c == 0.0) return;
     for (const auto& [a, p, q] : topology.gaussian.rim_corners) {
-        const glm::dvec3 xa = position.get(a);
-        const glm::dvec3 e1 = position.get(p) - xa, e2 = position.get(q) - xa;
-        const glm::dvec3 normal = glm::cross(e1, e2);
-        const double length = glm::length(normal);
-        if (!(length > 0.0)) continue;
-        const glm::dvec3 n = normal / length;
-        const glm::dvec3 fp = (c / glm::dot(e1, e1)) * glm::cross(e1, n);
-        const glm::dvec3 fq = (c / glm::dot(e2, e2)) * glm::cross(n, e2);
-        visit(a, -(fp + fq));
+        glm::dvec3 fa, fp, fq;
+        if (!corner_forces(position.get(a), position.get(p), position.get(q), c, fa, fp, fq)) continue;
+        visit(a, fa);
         visit(p, fp);
         visit(q, fq);
     }
@@ -70,11 +82,21 @@ void visit_gaussian_forces(const Topology& topology, const DVec3Array& position,
 
 // Adds F = c grad(sum of rim corners' angles) to `force`: per rim corner (a, p, q) with e_1 = x_p - x_a,
 // e_2 = x_q - x_a and n their unit normal, dphi/dx_p = (e_1 x n) / |e_1|^2, dphi/dx_q = (n x e_2) / |e_2|^2 and
-// dphi/dx_a their negated sum; each computed in double and added in F, corner by corner in list order. A corner
+// dphi/dx_a their negated sum (visit_gaussian_forces writes them without cross products); each computed in double and added in F, corner by corner in list order. A corner
 // with no normal (a collapsed triangle) adds nothing.
 template <class F>
 void accumulate_gaussian_forces(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
                                 BasicVec3Array<F>& force);
+// accumulate_gaussian_forces for the fast paths (the element gather, coloured XPBD): with the AVX-512 kernel
+// (FastSolver's choice, so the tests run every kernel the CPU has) eight corners at a time in double, in
+// visit_gaussian_forces' operations and order, each corner's forces then added in list order: bit-identical.
+void accumulate_gaussian_forces_fast(const Topology& topology, const DVec3Array& position, const SpringSettings& springs,
+                                     Vec3Array& force);
+// Rim corners [first, last) for the element gather: corner j's forces on a, p and q, rounded to float, at
+// out[slot + 3 (j - first)] and the next two (zero for a collapsed corner); with the AVX-512 kernel eight at a time,
+// bit-identical.
+void gaussian_corner_forces(const GaussianCurvature& term, const DVec3Array& position, double c, std::size_t first,
+                            std::size_t last, Vec3Array& out, std::size_t slot);
 // The term's energy, c (offset - sum of rim corners' angles) (J): 0 at any flat shape.
 double gaussian_energy(const Topology& topology, const DVec3Array& position, const SpringSettings& springs);
 
